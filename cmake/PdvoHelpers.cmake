@@ -1,0 +1,27 @@
+# pdvo_add_library(NAME <name> SRCS <files> [PUBLIC_LINK <libs>] [PRIVATE_LINK <libs>])
+# Builds pdvo_<name> from <name>/src, with public headers in <name>/include.
+function(pdvo_add_library)
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_LINK;PRIVATE_LINK" ${ARGN})
+  set(target pdvo_${ARG_NAME})
+  add_library(${target} STATIC ${ARG_SRCS})
+  target_include_directories(${target} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINK} PRIVATE ${ARG_PRIVATE_LINK})
+endfunction()
+
+# pdvo_add_test(LIB <lib> NAME <unit> [LINK <libs>] [LABELS <labels>])
+# One gtest executable per tests/<lib>/<unit>_test.cpp, registered as "<lib>/<unit>_test".
+function(pdvo_add_test)
+  cmake_parse_arguments(ARG "" "LIB;NAME" "LINK;LABELS" ${ARGN})
+  if(NOT PDVO_BUILD_TESTS)
+    return()
+  endif()
+  set(target ${ARG_LIB}_${ARG_NAME}_test)
+  add_executable(${target} ${CMAKE_SOURCE_DIR}/tests/${ARG_LIB}/${ARG_NAME}_test.cpp)
+  target_link_libraries(${target} PRIVATE ${ARG_LINK} pdvo_test_support GTest::gtest GTest::gtest_main)
+  set(labels unit)
+  if(ARG_LABELS)
+    set(labels ${ARG_LABELS})
+  endif()
+  gtest_discover_tests(${target} TEST_PREFIX "${ARG_LIB}/${ARG_NAME}_test." PROPERTIES LABELS "${labels}"
+                       DISCOVERY_TIMEOUT 60)
+endfunction()

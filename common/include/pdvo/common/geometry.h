@@ -1,0 +1,68 @@
+// Rigid and similarity transforms on Eigen, with the SO(3) / SE(3) exponential and logarithm maps.
+//
+// Convention: a transform named `b_from_a` maps coordinates in frame a to frame b, so
+// point_in_cam = cam_from_world * point_in_world. Quaternions are Hamilton, stored by Eigen as (x, y, z, w)
+// and constructed as (w, x, y, z); file formats (TUM) write them x y z w.
+// Tangent vectors of SE(3) are ordered (rho, phi): translation part first, rotation part second.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace pdvo {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// The skew-symmetric matrix [v]x with [v]x * w = v.cross(w).
+Eigen::Matrix3d Hat(const Eigen::Vector3d& v);
+
+// SO(3): rotation vector (axis * angle, radians) <-> rotation. Exact for small angles too.
+Eigen::Quaterniond ExpSO3(const Eigen::Vector3d& phi);
+Eigen::Vector3d LogSO3(const Eigen::Quaterniond& q);
+
+// The left Jacobian of SO(3) at phi, used by the SE(3) maps.
+Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& phi);
+
+// A rigid transform x -> rotation * x + translation.
+struct Rigid3d {
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Rigid3d() = default;
+  Rigid3d(const Eigen::Quaterniond& r, const Eigen::Vector3d& t) : rotation(r.normalized()), translation(t) {}
+
+  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const { return rotation * x + translation; }
+  Rigid3d operator*(const Rigid3d& other) const {
+    return Rigid3d(rotation * other.rotation, rotation * other.translation + translation);
+  }
+  Rigid3d Inverse() const {
+    const Eigen::Quaterniond inv = rotation.conjugate();
+    return Rigid3d(inv, -(inv * translation));
+  }
+  // The 3x4 matrix [R | t].
+  Eigen::Matrix<double, 3, 4> ToMatrix3x4() const;
+  // Builds from [R | t]; R is re-orthonormalised (nearest rotation).
+  static Rigid3d FromMatrix3x4(const Eigen::Matrix<double, 3, 4>& m);
+};
+
+// SE(3) exponential and logarithm with the (rho, phi) ordering.
+Rigid3d ExpSE3(const Vector6d& xi);
+Vector6d LogSE3(const Rigid3d& transform);
+
+// A similarity transform x -> scale * rotation * x + translation.
+struct Sim3d {
+  double scale = 1.0;
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const { return scale * (rotation * x) + translation; }
+  // Applies the similarity to a pose world_from_cam: positions are scaled, orientations rotated.
+  Rigid3d operator*(const Rigid3d& world_from_cam) const {
+    return Rigid3d(rotation * world_from_cam.rotation, *this * world_from_cam.translation);
+  }
+};
+
+// Angle between two rotations, in radians.
+double AngularDistance(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b);
+
+}  // namespace pdvo

@@ -1,0 +1,72 @@
+// Levelled, thread-safe logging to stderr and progress reporting for long work.
+//
+// The log level is the one process-wide setting (as OpenVINS' Printer); every tool sets it from --verbosity.
+// Libraries log through PDVO_LOG(level) << ...; long loops report through a Progress object, which draws a
+// bar with rate and ETA on a terminal and prints plain periodic lines otherwise (logs, CI).
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <sstream>
+#include <string>
+
+namespace pdvo {
+
+enum class LogLevel { kError = 0, kWarning = 1, kInfo = 2, kDebug = 3 };
+
+// Sets / reads the process-wide level; messages above it are dropped.
+void SetLogLevel(LogLevel level);
+LogLevel GetLogLevel();
+// Parses "error", "warning", "info", "debug" or 0..3; throws InvalidArgument otherwise.
+LogLevel ParseLogLevel(const std::string& text);
+
+namespace detail {
+// Collects one message and writes it, whole, to stderr when destroyed.
+class LogMessage {
+ public:
+  explicit LogMessage(LogLevel level) : level_(level) {}
+  ~LogMessage();
+  LogMessage(const LogMessage&) = delete;
+  LogMessage& operator=(const LogMessage&) = delete;
+  std::ostream& stream() { return stream_; }
+
+ private:
+  LogLevel level_;
+  std::ostringstream stream_;
+};
+}  // namespace detail
+
+// Reports progress of `total` steps named `what`. Call Step() after each step, Finish() at the end (the
+// destructor finishes too). On a terminal the bar is redrawn at most 10 times a second; otherwise a plain line
+// is printed every `plain_interval_s` seconds. Nothing is printed below LogLevel::kInfo.
+class Progress {
+ public:
+  Progress(std::string what, size_t total, double plain_interval_s = 5.0);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  void Step(size_t n = 1);
+  void Finish();
+  size_t done() const { return done_; }
+  // Steps per second so far.
+  double Rate() const;
+
+ private:
+  void Print(bool final_line);
+
+  std::string what_;
+  size_t total_;
+  size_t done_ = 0;
+  double plain_interval_s_;
+  bool tty_;
+  bool finished_ = false;
+  std::chrono::steady_clock::time_point start_, last_print_;
+};
+
+}  // namespace pdvo
+
+#define PDVO_LOG(level)                                                \
+  if (::pdvo::LogLevel::k##level > ::pdvo::GetLogLevel()) {            \
+  } else                                                               \
+    ::pdvo::detail::LogMessage(::pdvo::LogLevel::k##level).stream()

@@ -1,0 +1,172 @@
+// Options structs read from and written to YAML (cv::FileStorage), with unknown keys treated as errors.
+//
+// An options struct keeps its defaults in-class and lists its fields once, in a static visitor:
+//
+//   struct FooOptions {
+//     double max_angle_deg = 15.0;  // degrees
+//     BarOptions bar;               // nested options become a nested YAML map
+//     template <class Self, class V> static void Fields(Self& self, V& visit) {
+//       visit("max_angle_deg", self.max_angle_deg);
+//       visit("bar", self.bar);
+//     }
+//     bool Check() const;           // logs the bad field and returns false (COLMAP's CHECK_OPTION)
+//     bool operator==(const FooOptions&) const = default;
+//   };
+//
+// From that one list come reading (absent keys keep their defaults; unknown keys and wrong types throw
+// FormatError naming the file and the key), writing, and `--set key.sub=value` overrides.
+// Field types: bool, int, double, std::string, std::vector<double>, and nested options structs.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <set>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/common/logging.h"
+
+namespace pdvo {
+
+namespace detail {
+struct FieldProbe {
+  template <class T>
+  void operator()(const char*, T&) {}
+};
+}  // namespace detail
+
+template <class T>
+concept OptionsStruct = requires(T& t, detail::FieldProbe& probe) { T::Fields(t, probe); };
+
+// In a Check(): logs the failed condition and returns false.
+#define PDVO_CHECK_OPTION(cond)                                       \
+  do {                                                                \
+    if (!(cond)) {                                                    \
+      PDVO_LOG(Error) << "invalid option: " << #cond << " is false"; \
+      return false;                                                   \
+    }                                                                 \
+  } while (false)
+
+namespace detail {
+void ReadScalar(const cv::FileNode& node, const std::string& where, bool& value);
+void ReadScalar(const cv::FileNode& node, const std::string& where, int& value);
+void ReadScalar(const cv::FileNode& node, const std::string& where, double& value);
+void ReadScalar(const cv::FileNode& node, const std::string& where, std::string& value);
+void ReadScalar(const cv::FileNode& node, const std::string& where, std::vector<double>& value);
+void WriteScalar(cv::FileStorage& fs, const char* key, const bool& value);
+void WriteScalar(cv::FileStorage& fs, const char* key, const int& value);
+void WriteScalar(cv::FileStorage& fs, const char* key, const double& value);
+void WriteScalar(cv::FileStorage& fs, const char* key, const std::string& value);
+void WriteScalar(cv::FileStorage& fs, const char* key, const std::vector<double>& value);
+void ParseScalar(const std::string& text, const std::string& where, bool& value);
+void ParseScalar(const std::string& text, const std::string& where, int& value);
+void ParseScalar(const std::string& text, const std::string& where, double& value);
+void ParseScalar(const std::string& text, const std::string& where, std::string& value);
+void ParseScalar(const std::string& text, const std::string& where, std::vector<double>& value);
+void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known,
+                        const std::string& where);
+}  // namespace detail
+
+// Reads the fields of `options` from a YAML map; `where` names the file (and section) for error messages.
+template <OptionsStruct T>
+void ReadOptions(const cv::FileNode& node, T& options, const std::string& where) {
+  if (node.empty() || node.isNone()) return;
+  PDVO_THROW_CHECK(node.isMap(), FormatError, where << ": expected a map of options");
+  std::set<std::string> known;
+  auto visit = [&](const char* key, auto& field) {
+    known.insert(key);
+    const cv::FileNode child = node[key];
+    if (child.empty() || child.isNone()) return;
+    const std::string child_where = where + "." + key;
+    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+      ReadOptions(child, field, child_where);
+    } else {
+      detail::ReadScalar(child, child_where, field);
+    }
+  };
+  T::Fields(options, visit);
+  detail::ThrowIfUnknownKeys(node, known, where);
+}
+
+// Writes the fields of `options` into the currently open map of `fs`.
+template <OptionsStruct T>
+void WriteOptions(cv::FileStorage& fs, const T& options) {
+  auto visit = [&](const char* key, const auto& field) {
+    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+      fs << key << "{";
+      WriteOptions(fs, field);
+      fs << "}";
+    } else {
+      detail::WriteScalar(fs, key, field);
+    }
+  };
+  T::Fields(options, visit);
+}
+
+// Sets one field from text: key "a.b.c" names a nested field. Throws InvalidArgument for an unknown key or an
+// unparsable value.
+template <OptionsStruct T>
+void SetOption(T& options, const std::string& key, const std::string& value) {
+  const size_t dot = key.find('.');
+  const std::string head = key.substr(0, dot);
+  bool found = false;
+  auto visit = [&](const char* name, auto& field) {
+    if (head != name) return;
+    found = true;
+    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+      PDVO_THROW_CHECK(dot != std::string::npos, InvalidArgument,
+                       "option '" << key << "' is a group; name one of its fields");
+      SetOption(field, key.substr(dot + 1), value);
+    } else {
+      PDVO_THROW_CHECK(dot == std::string::npos, InvalidArgument, "unknown option '" << key << "'");
+      detail::ParseScalar(value, key, field);
+    }
+  };
+  T::Fields(options, visit);
+  PDVO_THROW_CHECK(found, InvalidArgument, "unknown option '" << key << "'");
+}
+
+// Applies "key=value" overrides (from repeated --set flags).
+template <OptionsStruct T>
+void ApplyOverrides(T& options, const std::vector<std::string>& assignments) {
+  for (const std::string& a : assignments) {
+    const size_t eq = a.find('=');
+    PDVO_THROW_CHECK(eq != std::string::npos && eq > 0, InvalidArgument,
+                     "--set expects key=value, got '" << a << "'");
+    SetOption(options, a.substr(0, eq), a.substr(eq + 1));
+  }
+}
+
+// Opens a YAML file for reading; throws IoError naming the file if it cannot be opened or parsed.
+cv::FileStorage OpenYamlForReading(const std::string& path);
+
+// Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them.
+template <OptionsStruct T>
+T LoadOptions(const std::string& path, const std::string& section = "") {
+  cv::FileStorage fs = OpenYamlForReading(path);
+  T options;
+  ReadOptions(section.empty() ? fs.root() : fs[section], options,
+              section.empty() ? path : path + ": " + section);
+  PDVO_THROW_CHECK(options.Check(), InvalidArgument, path << ": invalid options (see the message above)");
+  return options;
+}
+
+// Writes options as the map `section` of a new YAML file, atomically.
+template <OptionsStruct T>
+void SaveOptions(const std::string& path, const T& options, const std::string& section) {
+  cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  fs << section << "{";
+  WriteOptions(fs, options);
+  fs << "}";
+  WriteFileAtomically(path, fs.releaseAndGetString());
+}
+
+// Throws InvalidArgument if options.Check() fails; `what` names the options.
+template <OptionsStruct T>
+void CheckOptionsOrThrow(const T& options, const std::string& what) {
+  PDVO_THROW_CHECK(options.Check(), InvalidArgument, "invalid " << what << " (see the message above)");
+}
+
+}  // namespace pdvo

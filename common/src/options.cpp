@@ -1,0 +1,127 @@
+#include "pdvo/common/options.h"
+
+#include <charconv>
+#include <filesystem>
+#include <sstream>
+
+namespace pdvo {
+namespace detail {
+namespace {
+std::string TypeName(const cv::FileNode& node) {
+  if (node.isMap()) return "a map";
+  if (node.isSeq()) return "a list";
+  if (node.isString()) return "text '" + node.string() + "'";
+  return "a number";
+}
+
+double ParseDouble(const std::string& text, const std::string& where) {
+  double v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  PDVO_THROW_CHECK(ec == std::errc() && ptr == end, InvalidArgument,
+                   where << ": expected a number, got '" << text << "'");
+  return v;
+}
+}  // namespace
+
+void ReadScalar(const cv::FileNode& node, const std::string& where, bool& value) {
+  if (node.isInt()) {
+    value = static_cast<int>(node) != 0;
+    return;
+  }
+  PDVO_THROW_CHECK(node.isString(), FormatError, where << ": expected true or false, got " << TypeName(node));
+  ParseScalar(node.string(), where, value);
+}
+
+void ReadScalar(const cv::FileNode& node, const std::string& where, int& value) {
+  PDVO_THROW_CHECK(node.isInt(), FormatError, where << ": expected an integer, got " << TypeName(node));
+  value = static_cast<int>(node);
+}
+
+void ReadScalar(const cv::FileNode& node, const std::string& where, double& value) {
+  PDVO_THROW_CHECK(node.isInt() || node.isReal(), FormatError,
+                   where << ": expected a number, got " << TypeName(node));
+  value = static_cast<double>(node);
+}
+
+void ReadScalar(const cv::FileNode& node, const std::string& where, std::string& value) {
+  PDVO_THROW_CHECK(node.isString(), FormatError, where << ": expected text, got " << TypeName(node));
+  value = node.string();
+}
+
+void ReadScalar(const cv::FileNode& node, const std::string& where, std::vector<double>& value) {
+  PDVO_THROW_CHECK(node.isSeq(), FormatError, where << ": expected a list of numbers, got " << TypeName(node));
+  value.clear();
+  for (const cv::FileNode& item : node) {
+    PDVO_THROW_CHECK(item.isInt() || item.isReal(), FormatError,
+                     where << ": expected a list of numbers, found " << TypeName(item));
+    value.push_back(static_cast<double>(item));
+  }
+}
+
+void WriteScalar(cv::FileStorage& fs, const char* key, const bool& value) {
+  fs << key << (value ? "true" : "false");
+}
+void WriteScalar(cv::FileStorage& fs, const char* key, const int& value) { fs << key << value; }
+void WriteScalar(cv::FileStorage& fs, const char* key, const double& value) { fs << key << value; }
+void WriteScalar(cv::FileStorage& fs, const char* key, const std::string& value) { fs << key << value; }
+void WriteScalar(cv::FileStorage& fs, const char* key, const std::vector<double>& value) {
+  fs << key << "[:";
+  for (double v : value) fs << v;
+  fs << "]";
+}
+
+void ParseScalar(const std::string& text, const std::string& where, bool& value) {
+  if (text == "true" || text == "1") {
+    value = true;
+  } else if (text == "false" || text == "0") {
+    value = false;
+  } else {
+    PDVO_THROW(InvalidArgument, where << ": expected true or false, got '" << text << "'");
+  }
+}
+
+void ParseScalar(const std::string& text, const std::string& where, int& value) {
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  PDVO_THROW_CHECK(ec == std::errc() && ptr == end, InvalidArgument,
+                   where << ": expected an integer, got '" << text << "'");
+}
+
+void ParseScalar(const std::string& text, const std::string& where, double& value) {
+  value = ParseDouble(text, where);
+}
+
+void ParseScalar(const std::string& text, const std::string&, std::string& value) { value = text; }
+
+void ParseScalar(const std::string& text, const std::string& where, std::vector<double>& value) {
+  value.clear();
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) value.push_back(ParseDouble(item, where));
+}
+
+void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known,
+                        const std::string& where) {
+  for (const std::string& key : node.keys()) {
+    if (known.count(key)) continue;
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    PDVO_THROW(FormatError, where << ": unknown key '" << key << "' (known keys: " << list << ")");
+  }
+}
+}  // namespace detail
+
+cv::FileStorage OpenYamlForReading(const std::string& path) {
+  CheckExists(path);
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    PDVO_THROW(FormatError, path << ": not valid YAML (" << e.err << ")");
+  }
+  PDVO_THROW_CHECK(fs.isOpened(), IoError, path << ": cannot open as YAML");
+  return fs;
+}
+
+}  // namespace pdvo

@@ -1,0 +1,92 @@
+#include "pdvo/common/geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "pdvo/test/support.h"
+
+namespace pdvo {
+namespace {
+
+Eigen::Vector3d RandomVector(std::mt19937& rng, double scale) {
+  std::normal_distribution<double> n(0.0, scale);
+  return {n(rng), n(rng), n(rng)};
+}
+
+TEST(Geometry, HatIsTheCrossProduct) {
+  std::mt19937 rng(1);
+  for (int i = 0; i < 20; ++i) {
+    const Eigen::Vector3d a = RandomVector(rng, 1), b = RandomVector(rng, 1);
+    EXPECT_LT(test::MaxAbsDiff(Hat(a) * b, a.cross(b)), 1e-12);
+  }
+}
+
+TEST(Geometry, ExpLogSO3RoundTrip) {
+  std::mt19937 rng(2);
+  for (int i = 0; i < 100; ++i) {
+    // Angles up to just below pi, and tiny ones.
+    const Eigen::Vector3d phi = RandomVector(rng, i % 10 == 0 ? 1e-9 : 0.9);
+    if (phi.norm() >= M_PI - 1e-6) continue;
+    EXPECT_LT(test::MaxAbsDiff(LogSO3(ExpSO3(phi)), phi), 1e-9) << phi.transpose();
+  }
+}
+
+TEST(Geometry, ExpSO3MatchesAngleAxis) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, -2, 0.5).normalized();
+  const double angle = 1.2;
+  const Eigen::Matrix3d expected = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+  EXPECT_LT(test::MaxAbsDiff(ExpSO3(angle * axis).toRotationMatrix(), expected), 1e-12);
+}
+
+TEST(Geometry, ExpLogSE3RoundTrip) {
+  std::mt19937 rng(3);
+  for (int i = 0; i < 100; ++i) {
+    Vector6d xi;
+    xi.head<3>() = RandomVector(rng, 2.0);
+    xi.tail<3>() = RandomVector(rng, i % 10 == 0 ? 1e-9 : 0.8);
+    if (xi.tail<3>().norm() >= M_PI - 1e-6) continue;
+    EXPECT_LT(test::MaxAbsDiff(LogSE3(ExpSE3(xi)), xi), 1e-8) << xi.transpose();
+  }
+}
+
+TEST(Geometry, ExpSE3OfPureTranslationIsThatTranslation) {
+  Vector6d xi = Vector6d::Zero();
+  xi.head<3>() << 1, 2, 3;
+  const Rigid3d t = ExpSE3(xi);
+  EXPECT_LT(test::MaxAbsDiff(t.translation, Eigen::Vector3d(1, 2, 3)), 1e-15);
+  EXPECT_NEAR(t.rotation.w(), 1.0, 1e-15);
+}
+
+TEST(Geometry, RigidCompositionAndInverse) {
+  std::mt19937 rng(4);
+  for (int i = 0; i < 50; ++i) {
+    const Rigid3d a(ExpSO3(RandomVector(rng, 1)), RandomVector(rng, 3));
+    const Rigid3d b(ExpSO3(RandomVector(rng, 1)), RandomVector(rng, 3));
+    const Eigen::Vector3d x = RandomVector(rng, 5);
+    EXPECT_LT(test::MaxAbsDiff((a * b) * x, a * (b * x)), 1e-12);
+    EXPECT_LT(test::MaxAbsDiff(a.Inverse() * (a * x), x), 1e-12);
+    EXPECT_LT(test::MaxAbsDiff(Rigid3d::FromMatrix3x4(a.ToMatrix3x4()) * x, a * x), 1e-12);
+  }
+}
+
+TEST(Geometry, AngularDistanceOfAKnownRotation) {
+  const Eigen::Quaterniond a = ExpSO3(Eigen::Vector3d(0.1, 0.2, 0.3));
+  const Eigen::Quaterniond b = a * ExpSO3(Eigen::Vector3d(0, 0.25, 0));
+  EXPECT_NEAR(AngularDistance(a, b), 0.25, 1e-12);
+  // q and -q are the same rotation.
+  Eigen::Quaterniond neg = a;
+  neg.coeffs() *= -1;
+  EXPECT_NEAR(AngularDistance(a, neg), 0.0, 1e-9);
+}
+
+TEST(Geometry, SimilarityScalesPositions) {
+  Sim3d s;
+  s.scale = 2.0;
+  s.rotation = ExpSO3(Eigen::Vector3d(0, 0, M_PI / 2));
+  s.translation = Eigen::Vector3d(1, 0, 0);
+  EXPECT_LT(test::MaxAbsDiff(s * Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 2, 0)), 1e-12);
+}
+
+}  // namespace
+}  // namespace pdvo

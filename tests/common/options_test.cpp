@@ -1,0 +1,113 @@
+#include "pdvo/common/options.h"
+
+#include <gtest/gtest.h>
+
+#include "pdvo/common/file_io.h"
+#include "pdvo/test/support.h"
+
+namespace pdvo {
+namespace {
+
+struct InnerOptions {
+  int iterations = 10;
+  std::vector<double> weights = {1.0, 2.0};
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("iterations", self.iterations);
+    visit("weights", self.weights);
+  }
+  bool Check() const {
+    PDVO_CHECK_OPTION(iterations > 0);
+    return true;
+  }
+  bool operator==(const InnerOptions&) const = default;
+};
+
+struct OuterOptions {
+  double threshold = 0.5;
+  bool enabled = true;
+  std::string mode = "fast";
+  InnerOptions inner;
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("threshold", self.threshold);
+    visit("enabled", self.enabled);
+    visit("mode", self.mode);
+    visit("inner", self.inner);
+  }
+  bool Check() const {
+    PDVO_CHECK_OPTION(threshold >= 0);
+    return inner.Check();
+  }
+  bool operator==(const OuterOptions&) const = default;
+};
+
+TEST(Options, DefaultsAreEqualAndAModifiedCopyDiffers) {
+  OuterOptions a, b;
+  EXPECT_EQ(a, b);
+  b.inner.iterations = 11;
+  EXPECT_NE(a, b);
+}
+
+TEST(Options, WriteThenReadGivesTheSameOptions) {
+  test::TempDir dir;
+  OuterOptions written;
+  written.threshold = 0.25;
+  written.enabled = false;
+  written.mode = "slow";
+  written.inner.iterations = 3;
+  written.inner.weights = {0.5, -1.5, 7};
+  SaveOptions(dir / "o.yaml", written, "outer");
+  EXPECT_EQ(LoadOptions<OuterOptions>(dir / "o.yaml", "outer"), written);
+}
+
+TEST(Options, AbsentKeysKeepDefaults) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\nthreshold: 2.0\n");
+  OuterOptions expected;
+  expected.threshold = 2.0;
+  EXPECT_EQ(LoadOptions<OuterOptions>(dir / "o.yaml"), expected);
+}
+
+TEST(Options, UnknownKeyIsAnErrorNamingFileAndKey) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  iteratoins: 4\n");
+  try {
+    LoadOptions<OuterOptions>(dir / "o.yaml");
+    FAIL() << "expected FormatError";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("o.yaml.inner: unknown key 'iteratoins'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Options, WrongTypeIsAnError) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\nthreshold: high\n");
+  EXPECT_THROW(LoadOptions<OuterOptions>(dir / "o.yaml"), FormatError);
+}
+
+TEST(Options, CheckRejectsBadValues) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  iterations: 0\n");
+  EXPECT_THROW(LoadOptions<OuterOptions>(dir / "o.yaml"), InvalidArgument);
+}
+
+TEST(Options, MissingFileIsAnIoError) {
+  EXPECT_THROW(LoadOptions<OuterOptions>("/nonexistent/o.yaml"), IoError);
+}
+
+TEST(Options, OverridesSetNestedFields) {
+  OuterOptions o;
+  ApplyOverrides(o, {"inner.iterations=42", "enabled=false", "threshold=1e-3", "inner.weights=1,2,3"});
+  EXPECT_EQ(o.inner.iterations, 42);
+  EXPECT_FALSE(o.enabled);
+  EXPECT_DOUBLE_EQ(o.threshold, 1e-3);
+  EXPECT_EQ(o.inner.weights, (std::vector<double>{1, 2, 3}));
+  EXPECT_THROW(ApplyOverrides(o, {"inner.nope=1"}), InvalidArgument);
+  EXPECT_THROW(ApplyOverrides(o, {"threshold=abc"}), InvalidArgument);
+  EXPECT_THROW(ApplyOverrides(o, {"inner=3"}), InvalidArgument);
+  EXPECT_THROW(ApplyOverrides(o, {"novalue"}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo
