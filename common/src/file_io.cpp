@@ -77,4 +77,38 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
   WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
 }
 
+StagedOutputDir::StagedOutputDir(const std::string& final_dir) : final_dir_(final_dir) {
+  std::error_code ec;
+  fs::create_directories(final_dir, ec);
+  PDVO_THROW_CHECK(fs::is_directory(final_dir), IoError, final_dir << ": cannot create the output folder");
+  staging_dir_ = (fs::path(final_dir) / (".partial-" + std::to_string(getpid()))).string();
+  fs::remove_all(staging_dir_, ec);
+  fs::create_directories(staging_dir_, ec);
+  PDVO_THROW_CHECK(!ec, IoError, staging_dir_ << ": cannot create a staging folder");
+}
+
+StagedOutputDir::~StagedOutputDir() {
+  std::error_code ec;
+  fs::remove_all(staging_dir_, ec);
+}
+
+std::string StagedOutputDir::path(const std::string& name) const { return (fs::path(staging_dir_) / name).string(); }
+
+std::string StagedOutputDir::final_path(const std::string& name) const {
+  return (fs::path(final_dir_) / name).string();
+}
+
+void StagedOutputDir::Commit() {
+  std::error_code ec;
+  for (const auto& entry : fs::recursive_directory_iterator(staging_dir_)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path target = fs::path(final_dir_) / fs::relative(entry.path(), staging_dir_);
+    fs::create_directories(target.parent_path(), ec);
+    fs::rename(entry.path(), target, ec);
+    PDVO_THROW_CHECK(!ec, IoError, target.string() << ": cannot move output into place");
+  }
+  fs::remove_all(staging_dir_, ec);
+  committed_ = true;
+}
+
 }  // namespace pdvo

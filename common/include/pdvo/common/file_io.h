@@ -24,4 +24,25 @@ void WriteImage(const std::string& path, const cv::Mat& image);
 // Throws IoError naming `path` if it does not exist.
 void CheckExists(const std::string& path, const std::string& what = "file");
 
+// An output folder filled through a hidden staging folder inside it: files are written to path(name) and
+// moved into place only by Commit(), so a run that fails leaves no partial output. Files already in the
+// folder are kept, except those the run replaces on Commit().
+class StagedOutputDir {
+ public:
+  explicit StagedOutputDir(const std::string& final_dir);
+  ~StagedOutputDir();  // removes the staging folder unless committed
+  StagedOutputDir(const StagedOutputDir&) = delete;
+  StagedOutputDir& operator=(const StagedOutputDir&) = delete;
+
+  // Where to write the file `name` (may contain subfolders) until Commit().
+  std::string path(const std::string& name) const;
+  // Where the file `name` will be after Commit().
+  std::string final_path(const std::string& name) const;
+  void Commit();
+
+ private:
+  std::string final_dir_, staging_dir_;
+  bool committed_ = false;
+};
+
 }  // namespace pdvo

@@ -66,7 +66,15 @@ class Progress {
 
 }  // namespace pdvo
 
-#define PDVO_LOG(level)                                                \
-  if (::pdvo::LogLevel::k##level > ::pdvo::GetLogLevel()) {            \
-  } else                                                               \
-    ::pdvo::detail::LogMessage(::pdvo::LogLevel::k##level).stream()
+namespace pdvo::detail {
+// Turns the stream expression into void, so that PDVO_LOG works as one expression (safe in a braceless if).
+struct LogVoidify {
+  void operator&(std::ostream&) {}
+};
+}  // namespace pdvo::detail
+
+// PDVO_LOG(Info) << "message": the message is built only if the level is enabled.
+#define PDVO_LOG(level)                                              \
+  (::pdvo::LogLevel::k##level > ::pdvo::GetLogLevel())               \
+      ? (void)0                                                      \
+      : ::pdvo::detail::LogVoidify() & ::pdvo::detail::LogMessage(::pdvo::LogLevel::k##level).stream()

@@ -1,0 +1,80 @@
+// The plane annotation format (LabelMe JSON with a normal per plane; ../shared/ANNOTATIONS.md, v1): reading,
+// writing and validation. Detections are written in the same format.
+//
+// Reading keeps every key it does not interpret (LabelMe's `flags`, `group_id`, `description`, ...), so a
+// file read and written again loses nothing. Shapes with labels other than `plane` / `non-plane` are kept
+// but reported by Validate() and skipped by consumers. A LabelMe `rectangle` (two corners) is read as a
+// four-point polygon.
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pdvo {
+
+inline constexpr const char* kPlaneLabel = "plane";
+inline constexpr const char* kNonPlaneLabel = "non-plane";
+
+struct AnnotationShape {
+  std::string label;                      // "plane" or "non-plane"
+  std::vector<Eigen::Vector2d> points;    // pixels of the full-resolution image, (0,0) = top-left pixel centre
+  std::optional<Eigen::Vector3d> normal;  // planes: unit normal in the camera frame, towards the camera
+  std::optional<double> score;            // detector confidence in [0, 1]
+  nlohmann::json extra = nlohmann::json::object();  // other keys, kept as read
+
+  bool IsPlane() const { return label == kPlaneLabel; }
+  bool IsNonPlane() const { return label == kNonPlaneLabel; }
+};
+
+struct AnnotationCamera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels, at the image's full resolution
+};
+
+struct Annotation {
+  std::string version = "5.2.1";  // LabelMe version string
+  std::string image_path;         // relative to the JSON file's folder
+  int image_width = 0, image_height = 0;
+  std::optional<AnnotationCamera> camera;
+  std::vector<AnnotationShape> shapes;
+  nlohmann::json extra = nlohmann::json::object();  // other top-level keys (flags, ...), kept as read
+};
+
+// Parses JSON text; `where` names the source in errors. Throws FormatError for malformed JSON, a missing
+// required key or a value of the wrong type, naming the file, the shape and the key.
+Annotation ParseAnnotation(const std::string& json_text, const std::string& where);
+// Reads a file; IoError if it cannot be read, FormatError as above.
+Annotation ReadAnnotation(const std::string& path);
+// Serialises (2-space indented JSON, `imageData: null`).
+std::string AnnotationToJson(const Annotation& annotation);
+// Writes atomically.
+void WriteAnnotation(const std::string& path, const Annotation& annotation);
+
+// The image file of an annotation read from `json_path`.
+std::string ResolveImagePath(const Annotation& annotation, const std::string& json_path);
+
+struct ValidationIssue {
+  bool is_error = true;  // false: a warning
+  int shape = -1;        // index of the shape, or -1 for the file
+  std::string message;
+};
+
+// Checks an annotation against the format's rules. Errors: a bad image size, a shape type other than polygon,
+// fewer than 3 distinct points, a self-crossing polygon, points outside the image, a normal that is not
+// finite, zero, or (with a camera) points away from the camera, a score outside [0, 1], a plane and a
+// non-plane that overlap. Warnings: an unknown label, a normal on a non-plane, a normal that is not unit.
+std::vector<ValidationIssue> Validate(const Annotation& annotation);
+// One line per issue: "<where>: shape 2 (plane): polygon crosses itself".
+std::string FormatIssue(const ValidationIssue& issue, const Annotation& annotation, const std::string& where);
+// Logs the warnings and throws FormatError with the first error.
+void ValidateOrThrow(const Annotation& annotation, const std::string& where);
+
+// True if two polygon edges, other than neighbours, cross or touch. O(n^2) in the number of points.
+bool PolygonSelfIntersects(const std::vector<Eigen::Vector2d>& polygon);
+
+// Area of a simple polygon (shoelace), in square pixels.
+double PolygonArea(const std::vector<Eigen::Vector2d>& polygon);
+
+}  // namespace pdvo

@@ -1,0 +1,102 @@
+// Annotation from depth: finds the planes in a depth map and writes them as `plane` shapes with their normals,
+// and large clearly non-planar regions as `non-plane` shapes. Turns any RGB-D dataset into training data.
+//
+// Method, at a working resolution (default 320 px wide):
+//  1. Back-project the depth through the (distorted) camera; fit a plane to each pixel's (2r+1)^2
+//     neighbourhood from box-filtered moments, giving a local normal and RMS residual.
+//  2. Depth noise grows with depth: sigma(z) = a + b (z - z0)^2 (Nguyen, Izadi & Lovell 2012, for Kinect).
+//  3. Region growing from the flattest seeds: a neighbour joins a plane if its point lies within
+//     `inlier_sigmas` sigma(z) of the plane and its local normal within `max_normal_angle_deg`; the plane is
+//     refitted as the region doubles. A final least-squares fit gives the normal; pixels along the region's
+//     edge, whose local windows straddle the edge, are then recovered by the distance test alone.
+//  4. Regions above `min_plane_fraction` of the image become polygons: small holes are filled, larger ones
+//     are joined to the outside by a narrow cut (a "keyhole") so that the polygon leaves them out.
+//  5. Pixels whose local residual exceeds `nonplanar_residual` sigma(z), grouped into blobs that keep clear of
+//     the planes, become `non-plane` shapes if large enough.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "pdvo/annotations/annotation.h"
+#include "pdvo/common/camera.h"
+
+namespace pdvo {
+
+struct DepthPlaneOptions {
+  int working_width = 320;             // px; depth is processed at this width
+  double min_depth = 0.1;              // m; nearer readings are ignored
+  double max_depth = 6.0;              // m; farther readings are ignored
+  int normal_radius = 4;               // px at working width; local fits use (2r+1)^2 windows
+  double noise_a = 0.0012;             // m; sigma(z) = a + b (z - z0)^2
+  double noise_b = 0.0019;             // 1/m
+  double noise_z0 = 0.4;               // m
+  double inlier_sigmas = 5.0;          // point-to-plane threshold, in sigma(z)
+  double max_normal_angle_deg = 20.0;  // local normal vs plane normal, degrees
+  double seed_max_residual = 1.5;      // seeds' local RMS residual, in sigma(z)
+  double min_plane_fraction = 0.015;   // of the image area
+  double nonplanar_residual = 2.5;     // local RMS residual above which a pixel is non-planar, in sigma(z)
+  double min_nonplane_fraction = 0.02; // of the image area
+  double min_hole_fraction = 0.003;    // holes in a region larger than this are cut out, of the image area
+  double polygon_epsilon = 1.0;        // px at full resolution (Douglas-Peucker tolerance)
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("working_width", self.working_width);
+    visit("min_depth", self.min_depth);
+    visit("max_depth", self.max_depth);
+    visit("normal_radius", self.normal_radius);
+    visit("noise_a", self.noise_a);
+    visit("noise_b", self.noise_b);
+    visit("noise_z0", self.noise_z0);
+    visit("inlier_sigmas", self.inlier_sigmas);
+    visit("max_normal_angle_deg", self.max_normal_angle_deg);
+    visit("seed_max_residual", self.seed_max_residual);
+    visit("min_plane_fraction", self.min_plane_fraction);
+    visit("nonplanar_residual", self.nonplanar_residual);
+    visit("min_nonplane_fraction", self.min_nonplane_fraction);
+    visit("min_hole_fraction", self.min_hole_fraction);
+    visit("polygon_epsilon", self.polygon_epsilon);
+  }
+  bool Check() const;
+  bool operator==(const DepthPlaneOptions&) const = default;
+};
+
+// A plane found in a depth map, at working resolution.
+struct DepthPlane {
+  cv::Mat mask;              // CV_8U, 255 on the plane's pixels
+  Eigen::Vector3d normal;    // unit, camera frame, towards the camera
+  double distance = 0;       // m; the plane is normal . x + distance = 0 (distance > 0)
+  double rms_sigmas = 0;     // RMS point-to-plane residual, in sigma(z)
+};
+
+class DepthPlaneFinder {
+ public:
+  // `camera` is the depth map's camera (registered to the colour image); throws InvalidArgument for bad
+  // options.
+  DepthPlaneFinder(const Camera& camera, const DepthPlaneOptions& options);
+
+  // Planes (largest first) and the non-planar mask, at working resolution. `depth` is CV_32F metres (0 =
+  // unknown) of the camera's size; throws InvalidArgument otherwise.
+  std::vector<DepthPlane> FindPlanes(const cv::Mat& depth, cv::Mat* nonplanar_mask = nullptr) const;
+
+  // The annotation of one frame: planes, then non-planes. `image_path` is written as the imagePath.
+  Annotation Annotate(const cv::Mat& depth, const std::string& image_path) const;
+
+  cv::Size working_size() const { return working_.width > 0 ? cv::Size(working_.width, working_.height) : cv::Size(); }
+
+ private:
+  Camera camera_, working_;
+  DepthPlaneOptions options_;
+  cv::Mat source_x_, source_y_;  // CV_32S: the full-resolution pixel each working pixel samples
+  cv::Mat ray_x_, ray_y_;        // CV_64F: its viewing ray (x, y, 1)
+};
+
+// Polygons (full-resolution pixel coordinates) of the connected regions of `mask` larger than `min_pixels`:
+// holes larger than `min_hole_pixels` are cut out with keyholes, smaller ones filled. `mask` is at
+// working resolution; `scale` = full width / working width.
+std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask, int min_pixels, int min_hole_pixels,
+                                                         double scale, double epsilon_full_px);
+
+}  // namespace pdvo

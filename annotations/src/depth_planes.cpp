@@ -1,0 +1,360 @@
+#include "pdvo/annotations/depth_planes.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
+#include "pdvo/common/options.h"
+
+namespace pdvo {
+
+bool DepthPlaneOptions::Check() const {
+  PDVO_CHECK_OPTION(working_width >= 32);
+  PDVO_CHECK_OPTION(min_depth >= 0 && max_depth > min_depth);
+  PDVO_CHECK_OPTION(normal_radius >= 1 && normal_radius <= 20);
+  PDVO_CHECK_OPTION(noise_a > 0 && noise_b >= 0);
+  PDVO_CHECK_OPTION(inlier_sigmas > 0);
+  PDVO_CHECK_OPTION(max_normal_angle_deg > 0 && max_normal_angle_deg < 90);
+  PDVO_CHECK_OPTION(seed_max_residual > 0);
+  PDVO_CHECK_OPTION(min_plane_fraction > 0 && min_plane_fraction < 1);
+  PDVO_CHECK_OPTION(nonplanar_residual > 0);
+  PDVO_CHECK_OPTION(min_nonplane_fraction > 0 && min_nonplane_fraction < 1);
+  PDVO_CHECK_OPTION(min_hole_fraction >= 0 && min_hole_fraction < 1);
+  PDVO_CHECK_OPTION(polygon_epsilon >= 0);
+  return true;
+}
+
+namespace {
+
+// Sums of points and their outer products: least-squares plane fits, incrementally.
+struct PlaneAccumulator {
+  double n = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  void Add(const Eigen::Vector3d& p) {
+    n += 1;
+    sum += p;
+    outer += p * p.transpose();
+  }
+  // Normal (towards the camera at the origin) and distance of the best plane; the smallest eigenvalue of the
+  // covariance is the mean squared residual.
+  void Fit(Eigen::Vector3d* normal, double* distance, double* mse = nullptr) const {
+    const Eigen::Vector3d mean = sum / n;
+    const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov);
+    Eigen::Vector3d nrm = eig.eigenvectors().col(0);
+    if (nrm.dot(mean) > 0) nrm = -nrm;
+    *normal = nrm;
+    *distance = -nrm.dot(mean);
+    if (mse) *mse = std::max(0.0, eig.eigenvalues()(0));
+  }
+};
+
+struct LocalFits {
+  cv::Mat normal;    // CV_64FC3, 0 where unknown
+  cv::Mat residual;  // CV_64F, local RMS residual in sigma(z); -1 where unknown
+};
+
+double Sigma(const DepthPlaneOptions& o, double z) {
+  const double dz = z - o.noise_z0;
+  return o.noise_a + o.noise_b * dz * dz;
+}
+
+void FillSmallHolesAndCutLargeOnes(cv::Mat& mask, int min_hole_pixels) {
+  std::vector<std::vector<cv::Point>> contours;
+  std::vector<cv::Vec4i> hierarchy;
+  cv::findContours(mask.clone(), contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+  for (size_t i = 0; i < contours.size(); ++i) {
+    if (hierarchy[i][3] < 0) continue;  // an outer boundary, not a hole
+    // The hole's area in pixels: its contour runs through the region pixels around it.
+    cv::Mat hole(mask.size(), CV_8U, cv::Scalar(0));
+    cv::drawContours(hole, contours, static_cast<int>(i), cv::Scalar(255), cv::FILLED);
+    hole &= ~mask;
+    if (cv::countNonZero(hole) < min_hole_pixels) {
+      mask |= hole;
+      continue;
+    }
+    // A keyhole: a cut two pixels wide from the hole's top straight up, until it leaves the region.
+    const auto top = std::min_element(contours[i].begin(), contours[i].end(),
+                                      [](const cv::Point& a, const cv::Point& b) { return a.y < b.y; });
+    const int x = std::clamp(top->x, 0, mask.cols - 2);
+    for (int y = top->y; y >= 0; --y) {
+      if (mask.at<uchar>(y, x) == 0 && mask.at<uchar>(y, x + 1) == 0 && y < top->y) break;
+      mask.at<uchar>(y, x) = 0;
+      mask.at<uchar>(y, x + 1) = 0;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask_in, int min_pixels, int min_hole_pixels,
+                                                         double scale, double epsilon_full_px) {
+  cv::Mat mask = mask_in > 0;
+  // Opening removes one-pixel necks and spurs, whose contours would touch themselves.
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  FillSmallHolesAndCutLargeOnes(mask, min_hole_pixels);
+  std::vector<std::vector<Eigen::Vector2d>> polygons;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  for (const auto& contour : contours) {
+    if (cv::contourArea(contour) < min_pixels) continue;
+    // Try the requested tolerance, then finer ones, until the polygon does not cross itself.
+    for (double eps = epsilon_full_px / scale; eps >= 0.05; eps *= 0.5) {
+      std::vector<cv::Point> simple;
+      cv::approxPolyDP(contour, simple, eps, true);
+      std::vector<Eigen::Vector2d> polygon;
+      for (const cv::Point& p : simple) polygon.emplace_back((p.x + 0.5) * scale - 0.5, (p.y + 0.5) * scale - 0.5);
+      if (polygon.size() >= 3 && !PolygonSelfIntersects(polygon)) {
+        polygons.push_back(std::move(polygon));
+        break;
+      }
+    }
+  }
+  return polygons;
+}
+
+DepthPlaneFinder::DepthPlaneFinder(const Camera& camera, const DepthPlaneOptions& options)
+    : camera_(camera), options_(options) {
+  camera.Check("annotate-depth camera");
+  CheckOptionsOrThrow(options, "annotate-depth options");
+  const int w = std::min(options.working_width, camera.width);
+  const int h = static_cast<int>(std::lround(static_cast<double>(camera.height) * w / camera.width));
+  working_ = camera.Undistorted().Rescaled(w, h);
+  source_x_.create(h, w, CV_32S);
+  source_y_.create(h, w, CV_32S);
+  ray_x_.create(h, w, CV_64F);
+  ray_y_.create(h, w, CV_64F);
+  std::vector<cv::Point2d> pixels;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int x = std::min(camera.width - 1, static_cast<int>((u + 0.5) * camera.width / w));
+      const int y = std::min(camera.height - 1, static_cast<int>((v + 0.5) * camera.height / h));
+      source_x_.at<int>(v, u) = x;
+      source_y_.at<int>(v, u) = y;
+      pixels.emplace_back(x, y);
+    }
+  }
+  const std::vector<cv::Point2d> ideal = camera.UndistortPoints(pixels);
+  for (int i = 0; i < w * h; ++i) {
+    ray_x_.at<double>(i) = (ideal[i].x - camera.cx) / camera.fx;
+    ray_y_.at<double>(i) = (ideal[i].y - camera.cy) / camera.fy;
+  }
+}
+
+std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::Mat* nonplanar_mask) const {
+  PDVO_THROW_CHECK(depth.type() == CV_32F, InvalidArgument, "annotate-depth: depth must be CV_32F metres");
+  PDVO_THROW_CHECK(depth.cols == camera_.width && depth.rows == camera_.height, InvalidArgument,
+                   "annotate-depth: depth is " << depth.cols << "x" << depth.rows << " but the camera is "
+                                               << camera_.width << "x" << camera_.height);
+  const DepthPlaneOptions& o = options_;
+  const int w = ray_x_.cols, h = ray_x_.rows, n_pixels = w * h;
+
+  // 1. Points at working resolution, and their moments for local fits.
+  std::vector<Eigen::Vector3d> points(n_pixels, Eigen::Vector3d::Zero());
+  std::vector<double> sigma(n_pixels, 0);
+  std::vector<uint8_t> valid(n_pixels, 0);
+  cv::Mat moments(h, w, CV_64FC(10), cv::Scalar::all(0));
+  for (int i = 0; i < n_pixels; ++i) {
+    const float z = depth.at<float>(source_y_.at<int>(i), source_x_.at<int>(i));
+    if (!(z > o.min_depth && z < o.max_depth)) continue;
+    const Eigen::Vector3d p(z * ray_x_.at<double>(i), z * ray_y_.at<double>(i), z);
+    points[i] = p;
+    sigma[i] = Sigma(o, z);
+    valid[i] = 1;
+    double* m = moments.ptr<double>(0) + 10 * i;
+    m[0] = 1;
+    m[1] = p.x(), m[2] = p.y(), m[3] = p.z();
+    m[4] = p.x() * p.x(), m[5] = p.x() * p.y(), m[6] = p.x() * p.z();
+    m[7] = p.y() * p.y(), m[8] = p.y() * p.z(), m[9] = p.z() * p.z();
+  }
+  const int r = o.normal_radius, window = (2 * r + 1) * (2 * r + 1);
+  cv::Mat sums;
+  cv::boxFilter(moments, sums, CV_64F, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
+
+  // 2. Local plane fits: normal and RMS residual (in sigma) per pixel with enough valid neighbours.
+  std::vector<Eigen::Vector3d> local_normal(n_pixels, Eigen::Vector3d::Zero());
+  std::vector<double> local_residual(n_pixels, -1);
+  for (int i = 0; i < n_pixels; ++i) {
+    if (!valid[i]) continue;
+    const double* s = sums.ptr<double>(0) + 10 * i;
+    if (s[0] < 0.6 * window) continue;
+    const Eigen::Vector3d mean(s[1] / s[0], s[2] / s[0], s[3] / s[0]);
+    Eigen::Matrix3d cov;
+    cov << s[4], s[5], s[6], s[5], s[7], s[8], s[6], s[8], s[9];
+    cov = cov / s[0] - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(cov);
+    Eigen::Vector3d nrm = eig.eigenvectors().col(0);
+    if (nrm.dot(mean) > 0) nrm = -nrm;
+    local_normal[i] = nrm;
+    local_residual[i] = std::sqrt(std::max(0.0, eig.eigenvalues()(0))) / sigma[i];
+  }
+
+  // 3. Region growing from the flattest seeds.
+  std::vector<int> order;
+  for (int i = 0; i < n_pixels; ++i) {
+    if (local_residual[i] >= 0 && local_residual[i] < o.seed_max_residual) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return local_residual[a] < local_residual[b]; });
+  const double cos_max = std::cos(o.max_normal_angle_deg * M_PI / 180.0);
+  const int min_plane_pixels = static_cast<int>(o.min_plane_fraction * n_pixels);
+  std::vector<int> label(n_pixels, -1);
+  std::vector<uint8_t> seeded(n_pixels, 0);
+  std::vector<DepthPlane> planes;
+  std::vector<int> region, queue;
+  const int offsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  auto inlier = [&](int q, const Eigen::Vector3d& normal, double distance) {
+    return std::abs(normal.dot(points[q]) + distance) < o.inlier_sigmas * sigma[q];
+  };
+  for (int seed : order) {
+    if (label[seed] >= 0 || seeded[seed]) continue;
+    const int id = static_cast<int>(planes.size());
+    Eigen::Vector3d normal = local_normal[seed];
+    double distance = -normal.dot(points[seed]);
+    PlaneAccumulator acc;
+    region.assign(1, seed);
+    queue.assign(1, seed);
+    label[seed] = id;
+    acc.Add(points[seed]);
+    size_t next_refit = 32;
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int p = queue[head];
+      const int px = p % w, py = p / w;
+      for (const auto& d : offsets) {
+        const int qx = px + d[0], qy = py + d[1];
+        if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+        const int q = qy * w + qx;
+        if (label[q] >= 0 || !valid[q]) continue;
+        if (local_residual[q] < 0 || local_normal[q].dot(normal) < cos_max) continue;
+        if (!inlier(q, normal, distance)) continue;
+        label[q] = id;
+        region.push_back(q);
+        queue.push_back(q);
+        acc.Add(points[q]);
+      }
+      if (region.size() >= next_refit) {
+        acc.Fit(&normal, &distance);
+        next_refit *= 2;
+      }
+    }
+    for (int q : region) seeded[q] = 1;
+    if (static_cast<int>(region.size()) < min_plane_pixels) {
+      for (int q : region) label[q] = -1;
+      continue;
+    }
+    // The final fit, then the pixels along the edge whose windows straddled it: distance test only,
+    // out to the window radius.
+    acc.Fit(&normal, &distance);
+    std::vector<int> frontier = region;
+    for (int ring = 0; ring <= r && !frontier.empty(); ++ring) {
+      std::vector<int> next;
+      for (int p : frontier) {
+        const int px = p % w, py = p / w;
+        for (const auto& d : offsets) {
+          const int qx = px + d[0], qy = py + d[1];
+          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+          const int q = qy * w + qx;
+          if (label[q] >= 0 || !valid[q] || !inlier(q, normal, distance)) continue;
+          label[q] = id;
+          region.push_back(q);
+          next.push_back(q);
+        }
+      }
+      frontier.swap(next);
+    }
+    PlaneAccumulator final_acc;
+    for (int q : region) final_acc.Add(points[q]);
+    DepthPlane plane;
+    final_acc.Fit(&plane.normal, &plane.distance);
+    double sq = 0;
+    for (int q : region) {
+      const double e = (plane.normal.dot(points[q]) + plane.distance) / sigma[q];
+      sq += e * e;
+    }
+    plane.rms_sigmas = std::sqrt(sq / static_cast<double>(region.size()));
+    plane.mask = cv::Mat(h, w, CV_8U, cv::Scalar(0));
+    for (int q : region) plane.mask.at<uchar>(q) = 255;
+    planes.push_back(std::move(plane));
+  }
+  std::stable_sort(planes.begin(), planes.end(), [](const DepthPlane& a, const DepthPlane& b) {
+    return cv::countNonZero(a.mask) > cv::countNonZero(b.mask);
+  });
+
+  // 4. Clearly non-planar pixels: a high local residual, away from every plane.
+  if (nonplanar_mask) {
+    cv::Mat rough(h, w, CV_8U, cv::Scalar(0));
+    for (int i = 0; i < n_pixels; ++i) {
+      if (local_residual[i] > o.nonplanar_residual && label[i] < 0) rough.at<uchar>(i) = 255;
+    }
+    // Opening drops the thin lines along depth edges; closing joins what is left into blobs.
+    cv::morphologyEx(rough, rough, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+    cv::morphologyEx(rough, rough, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(9, 9)));
+    *nonplanar_mask = rough;
+  }
+  return planes;
+}
+
+Annotation DepthPlaneFinder::Annotate(const cv::Mat& depth, const std::string& image_path) const {
+  cv::Mat nonplanar;
+  const std::vector<DepthPlane> planes = FindPlanes(depth, &nonplanar);
+  const int n_pixels = ray_x_.cols * ray_x_.rows;
+  const double scale = static_cast<double>(camera_.width) / ray_x_.cols;
+  const int min_hole = std::max(4, static_cast<int>(options_.min_hole_fraction * n_pixels));
+
+  Annotation a;
+  a.image_path = image_path;
+  a.image_width = camera_.width;
+  a.image_height = camera_.height;
+  a.camera = AnnotationCamera{camera_.fx, camera_.fy, camera_.cx, camera_.cy};
+  cv::Mat covered(ray_x_.rows, ray_x_.cols, CV_8U, cv::Scalar(0));
+  for (const DepthPlane& plane : planes) {
+    for (auto& polygon : MaskToPolygons(plane.mask, static_cast<int>(options_.min_plane_fraction * n_pixels),
+                                        min_hole, scale, options_.polygon_epsilon)) {
+      AnnotationShape shape;
+      shape.label = kPlaneLabel;
+      shape.points = std::move(polygon);
+      shape.normal = plane.normal;
+      a.shapes.push_back(std::move(shape));
+      cv::Mat filled = RasteriseShape(a.shapes.back(), a, covered.size());
+      covered |= filled;
+    }
+  }
+  // Non-planes keep a margin from the planes' polygons, so that no region of one label overlaps the other.
+  const int margin = 2 + static_cast<int>(std::ceil(2 * options_.polygon_epsilon / scale));
+  cv::dilate(covered, covered, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
+  nonplanar &= ~covered;
+  for (auto& polygon : MaskToPolygons(nonplanar, static_cast<int>(options_.min_nonplane_fraction * n_pixels),
+                                      min_hole, scale, options_.polygon_epsilon)) {
+    AnnotationShape shape;
+    shape.label = kNonPlaneLabel;
+    shape.points = std::move(polygon);
+    a.shapes.push_back(std::move(shape));
+  }
+  // Anything that still breaks the format's rules (it should not) is dropped rather than written.
+  std::vector<bool> drop(a.shapes.size(), false);
+  for (const ValidationIssue& issue : Validate(a)) {
+    if (issue.is_error && issue.shape >= 0) drop[issue.shape] = true;
+  }
+  std::vector<AnnotationShape> kept;
+  for (size_t i = 0; i < a.shapes.size(); ++i) {
+    if (!drop[i]) {
+      kept.push_back(std::move(a.shapes[i]));
+    } else {
+      PDVO_LOG(Debug) << image_path << ": dropped shape " << i << " that broke the format's rules";
+    }
+  }
+  a.shapes = std::move(kept);
+  return a;
+}
+
+}  // namespace pdvo

@@ -1,0 +1,62 @@
+// pdvo ate: absolute trajectory error after alignment, and relative pose error.
+#include <cstdio>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/common/logging.h"
+#include "pdvo/common/trajectory.h"
+#include "pdvo/eval/trajectory_error.h"
+#include "tool.h"
+
+namespace pdvo::apps {
+
+int RunAte(int argc, char** argv) {
+  CLI::App app("Compares an estimated trajectory with ground truth: poses are associated by timestamp, the "
+               "estimate is aligned (se3: rigid; sim3: with scale, for monocular runs; none), and the absolute "
+               "trajectory error (ATE) and the relative pose error (RPE) are reported.",
+               "pdvo ate");
+  std::string gt_path, est_path, format_name = "tum", align_name = "sim3", gt_times, est_times, json_path;
+  std::string rpe_unit = "frames", verbosity = "info";
+  double max_dt = 0.02, rpe_delta = 1;
+  app.add_option("--gt", gt_path, "Ground-truth trajectory")->required();
+  app.add_option("--est", est_path, "Estimated trajectory")->required();
+  app.add_option("--format", format_name, "Trajectory format: tum (t tx ty tz qx qy qz qw) or kitti (3x4 rows)")
+      ->capture_default_str();
+  app.add_option("--align", align_name, "Alignment: se3, sim3 or none")->capture_default_str();
+  app.add_option("--max-dt", max_dt, "Largest time difference of associated poses, seconds")->capture_default_str();
+  app.add_option("--gt-times", gt_times, "KITTI: times file of the ground truth (default: pose index)");
+  app.add_option("--est-times", est_times, "KITTI: times file of the estimate (default: pose index)");
+  app.add_option("--rpe-delta", rpe_delta, "RPE: distance between compared poses")->capture_default_str();
+  app.add_option("--rpe-unit", rpe_unit, "RPE: delta in frames or seconds")->capture_default_str();
+  app.add_option("--json", json_path, "Write the results as JSON");
+  AddVerbosityFlag(app, &verbosity);
+  CLI11_PARSE(app, argc, argv);
+  ApplyVerbosity(verbosity);
+  PDVO_THROW_CHECK(rpe_unit == "frames" || rpe_unit == "seconds", InvalidArgument,
+                   "--rpe-unit must be frames or seconds, got '" << rpe_unit << "'");
+
+  const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
+  const Alignment alignment = ParseAlignment(align_name);
+  const Trajectory gt = ReadTrajectory(gt_path, format, gt_times);
+  const Trajectory est = ReadTrajectory(est_path, format, est_times);
+  const AteResult ate = ComputeAte(gt, est, alignment, max_dt);
+  const RpeResult rpe = ComputeRpe(gt, est, max_dt, rpe_delta,
+                                   rpe_unit == "frames" ? RpeUnit::kFrames : RpeUnit::kSeconds,
+                                   ate.gt_from_estimate.scale);
+  std::printf("matched poses   %zu of %zu (ground truth %zu)\n", ate.matched, est.size(), gt.size());
+  std::printf("alignment       %s, scale %.6f\n", align_name.c_str(), ate.gt_from_estimate.scale);
+  std::printf("ATE translation rmse %.6f  mean %.6f  median %.6f  max %.6f\n", ate.translation.rmse,
+              ate.translation.mean, ate.translation.median, ate.translation.max);
+  std::printf("ATE rotation    rmse %.4f  mean %.4f  median %.4f  max %.4f deg\n", ate.rotation_deg.rmse,
+              ate.rotation_deg.mean, ate.rotation_deg.median, ate.rotation_deg.max);
+  std::printf("RPE (%g %s, %zu pairs) translation rmse %.6f, rotation rmse %.4f deg\n", rpe_delta,
+              rpe_unit.c_str(), rpe.pairs, rpe.translation.rmse, rpe.rotation_deg.rmse);
+  if (!json_path.empty()) {
+    nlohmann::json j = {{"gt", gt_path}, {"est", est_path}, {"align", align_name}, {"max_dt", max_dt},
+                        {"ate", ToJson(ate)}, {"rpe", ToJson(rpe)}};
+    WriteFileAtomically(json_path, j.dump(1) + "\n");
+  }
+  return 0;
+}
+
+}  // namespace pdvo::apps

@@ -1,0 +1,81 @@
+// The `pdvo` command: one binary, one subcommand per job. main() turns every error into one line on stderr
+// and an exit code: 1 for a usage error, 2 for a failure while running.
+#include <cstring>
+#include <iostream>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "pdvo/common/errors.h"
+#include "tool.h"
+
+namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(int, char**);
+  const char* summary;
+};
+
+constexpr Command kCommands[] = {
+    {"show", pdvo::apps::RunShow, "draw an annotation over its image, planes tinted by their normal"},
+    {"validate", pdvo::apps::RunValidate, "check annotation files against the format's rules"},
+    {"annotate-depth", pdvo::apps::RunAnnotateDepth, "find planes in RGB-D depth maps and write annotations"},
+    {"compare", pdvo::apps::RunCompare, "match estimated planes to reference annotations: IoU, normal angle"},
+    {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
+};
+
+void PrintUsage(std::ostream& out) {
+  out << "pdvo " << PDVO_VERSION << " (" << PDVO_GIT_HASH << "): planes recognised in single images as priors "
+      << "for monocular visual odometry\n\nUsage: pdvo <command> [options]   (pdvo <command> --help for more)\n\n"
+      << "Commands:\n";
+  for (const Command& c : kCommands) {
+    out << "  " << c.name << std::string(16 - std::strlen(c.name), ' ') << c.summary << "\n";
+  }
+}
+
+std::string OneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    PrintUsage(std::cerr);
+    return 1;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    PrintUsage(std::cout);
+    return 0;
+  }
+  if (name == "--version") {
+    std::cout << "pdvo " << PDVO_VERSION << " (" << PDVO_GIT_HASH << ")\n";
+    return 0;
+  }
+  for (const Command& c : kCommands) {
+    if (name != c.name) continue;
+    const std::string prefix = "pdvo " + name + ": error: ";
+    try {
+      return c.run(argc - 1, argv + 1);
+    } catch (const pdvo::InvalidArgument& e) {
+      std::cerr << prefix << OneLine(e.what()) << "\n";
+      return 1;
+    } catch (const pdvo::Error& e) {
+      std::cerr << prefix << OneLine(e.what()) << "\n";
+      return 2;
+    } catch (const cv::Exception& e) {
+      std::cerr << prefix << "OpenCV: " << OneLine(e.err) << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << prefix << OneLine(e.what()) << "\n";
+      return 2;
+    }
+  }
+  std::cerr << "pdvo: unknown command '" << name << "'\n\n";
+  PrintUsage(std::cerr);
+  return 1;
+}

@@ -1,0 +1,48 @@
+// Comparing estimated planes (detections, or annotations made from depth) with reference annotations.
+//
+// Planes are matched one to one, greedily by intersection over union of their masks (highest first), above
+// `min_iou`. For each match: IoU and the angle between the normals. Masks are compared at the reference
+// image's size (or scaled to `max_width`).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "pdvo/annotations/annotation.h"
+
+namespace pdvo {
+
+struct PlaneMatch {
+  int reference_shape = -1, estimated_shape = -1;
+  double iou = 0;
+  double normal_angle_deg = -1;  // -1 if either has no normal
+};
+
+struct PlaneComparison {
+  std::string name;  // the frame, for reports
+  int reference_planes = 0, estimated_planes = 0;
+  std::vector<PlaneMatch> matches;
+};
+
+struct PlaneMatchOptions {
+  double min_iou = 0.1;  // pairs below this are not matched
+  int max_width = 640;   // masks are compared at most this wide
+};
+
+// Throws InvalidArgument if the two annotations are of different image sizes.
+PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& estimate,
+                              const PlaneMatchOptions& options = {});
+
+struct PlaneComparisonSummary {
+  int frames = 0, reference_planes = 0, matched = 0;
+  double median_iou = 0, mean_iou = 0;                 // over reference planes, 0 for unmatched ones
+  double median_normal_angle_deg = 0, mean_normal_angle_deg = 0, p90_normal_angle_deg = 0;  // over matches
+};
+
+PlaneComparisonSummary Summarise(const std::vector<PlaneComparison>& comparisons);
+
+// {"summary": {...}, "frames": [{"name", "reference_planes", "estimated_planes", "matches": [...]}]}
+nlohmann::json ToJson(const std::vector<PlaneComparison>& comparisons);
+
+}  // namespace pdvo

@@ -1,0 +1,149 @@
+#include "pdvo/eval/plane_match.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / static_cast<double>(v.size());
+}
+
+}  // namespace
+
+PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& estimate,
+                              const PlaneMatchOptions& options) {
+  PDVO_THROW_CHECK(reference.image_width == estimate.image_width && reference.image_height == estimate.image_height,
+                   InvalidArgument,
+                   "compare: reference is " << reference.image_width << "x" << reference.image_height
+                                            << " but the estimate is " << estimate.image_width << "x"
+                                            << estimate.image_height);
+  const double scale = std::min(1.0, static_cast<double>(options.max_width) / reference.image_width);
+  const cv::Size size(static_cast<int>(std::lround(reference.image_width * scale)),
+                      static_cast<int>(std::lround(reference.image_height * scale)));
+  auto plane_masks = [&](const Annotation& a, std::vector<int>* index) {
+    std::vector<cv::Mat> masks;
+    for (size_t i = 0; i < a.shapes.size(); ++i) {
+      if (!a.shapes[i].IsPlane()) continue;
+      masks.push_back(RasteriseShape(a.shapes[i], a, size));
+      index->push_back(static_cast<int>(i));
+    }
+    return masks;
+  };
+  std::vector<int> ref_index, est_index;
+  const std::vector<cv::Mat> ref = plane_masks(reference, &ref_index);
+  const std::vector<cv::Mat> est = plane_masks(estimate, &est_index);
+
+  struct Candidate {
+    double iou;
+    size_t r, e;
+  };
+  std::vector<Candidate> candidates;
+  for (size_t r = 0; r < ref.size(); ++r) {
+    const int ref_area = cv::countNonZero(ref[r]);
+    for (size_t e = 0; e < est.size(); ++e) {
+      const int inter = cv::countNonZero(ref[r] & est[e]);
+      if (inter == 0) continue;
+      const double iou = inter / static_cast<double>(ref_area + cv::countNonZero(est[e]) - inter);
+      if (iou >= options.min_iou) candidates.push_back({iou, r, e});
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.iou > b.iou; });
+  PlaneComparison out;
+  out.reference_planes = static_cast<int>(ref.size());
+  out.estimated_planes = static_cast<int>(est.size());
+  std::vector<bool> ref_used(ref.size(), false), est_used(est.size(), false);
+  for (const Candidate& c : candidates) {
+    if (ref_used[c.r] || est_used[c.e]) continue;
+    ref_used[c.r] = est_used[c.e] = true;
+    PlaneMatch m;
+    m.reference_shape = ref_index[c.r];
+    m.estimated_shape = est_index[c.e];
+    m.iou = c.iou;
+    const auto& nr = reference.shapes[m.reference_shape].normal;
+    const auto& ne = estimate.shapes[m.estimated_shape].normal;
+    if (nr && ne && nr->norm() > 0 && ne->norm() > 0) {
+      const double cosine = std::clamp(nr->normalized().dot(ne->normalized()), -1.0, 1.0);
+      m.normal_angle_deg = std::acos(cosine) * 180.0 / M_PI;
+    }
+    out.matches.push_back(m);
+  }
+  return out;
+}
+
+PlaneComparisonSummary Summarise(const std::vector<PlaneComparison>& comparisons) {
+  PlaneComparisonSummary s;
+  std::vector<double> ious, angles;
+  for (const PlaneComparison& c : comparisons) {
+    ++s.frames;
+    s.reference_planes += c.reference_planes;
+    s.matched += static_cast<int>(c.matches.size());
+    for (const PlaneMatch& m : c.matches) {
+      ious.push_back(m.iou);
+      if (m.normal_angle_deg >= 0) angles.push_back(m.normal_angle_deg);
+    }
+    // Unmatched reference planes count as IoU 0.
+    for (int k = static_cast<int>(c.matches.size()); k < c.reference_planes; ++k) ious.push_back(0.0);
+  }
+  s.median_iou = Median(ious);
+  s.mean_iou = Mean(ious);
+  s.median_normal_angle_deg = Median(angles);
+  s.mean_normal_angle_deg = Mean(angles);
+  s.p90_normal_angle_deg = Percentile(angles, 0.9);
+  return s;
+}
+
+nlohmann::json ToJson(const std::vector<PlaneComparison>& comparisons) {
+  const PlaneComparisonSummary s = Summarise(comparisons);
+  nlohmann::json j;
+  j["summary"] = {{"frames", s.frames},
+                  {"reference_planes", s.reference_planes},
+                  {"matched", s.matched},
+                  {"median_iou", s.median_iou},
+                  {"mean_iou", s.mean_iou},
+                  {"median_normal_angle_deg", s.median_normal_angle_deg},
+                  {"mean_normal_angle_deg", s.mean_normal_angle_deg},
+                  {"p90_normal_angle_deg", s.p90_normal_angle_deg}};
+  nlohmann::json frames = nlohmann::json::array();
+  for (const PlaneComparison& c : comparisons) {
+    nlohmann::json matches = nlohmann::json::array();
+    for (const PlaneMatch& m : c.matches) {
+      matches.push_back({{"reference_shape", m.reference_shape},
+                         {"estimated_shape", m.estimated_shape},
+                         {"iou", m.iou},
+                         {"normal_angle_deg", m.normal_angle_deg}});
+    }
+    frames.push_back({{"name", c.name},
+                      {"reference_planes", c.reference_planes},
+                      {"estimated_planes", c.estimated_planes},
+                      {"matches", matches}});
+  }
+  j["frames"] = frames;
+  return j;
+}
+
+}  // namespace pdvo
