@@ -21,8 +21,10 @@ bool DepthPlaneOptions::Check() const {
   PDVO_CHECK_OPTION(inlier_sigmas > 0);
   PDVO_CHECK_OPTION(max_normal_angle_deg > 0 && max_normal_angle_deg < 90);
   PDVO_CHECK_OPTION(seed_max_residual > 0);
+  PDVO_CHECK_OPTION(merge_angle_deg >= 0 && merge_angle_deg < 90);
   PDVO_CHECK_OPTION(min_plane_fraction > 0 && min_plane_fraction < 1);
   PDVO_CHECK_OPTION(nonplanar_residual > 0);
+  PDVO_CHECK_OPTION(nonplanar_dispersion > 0 && nonplanar_dispersion <= 1);
   PDVO_CHECK_OPTION(min_nonplane_fraction > 0 && min_nonplane_fraction < 1);
   PDVO_CHECK_OPTION(min_hole_fraction >= 0 && min_hole_fraction < 1);
   PDVO_CHECK_OPTION(polygon_epsilon >= 0);
@@ -31,20 +33,21 @@ bool DepthPlaneOptions::Check() const {
 
 namespace {
 
-// Sums of points and their outer products: least-squares plane fits, incrementally.
+// Weighted sums of points and their outer products: least-squares plane fits, incrementally. Points are
+// weighted by 1 / sigma(z)^2, so that far, noisy points do not bias the fit.
 struct PlaneAccumulator {
   double n = 0;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
 
-  void Add(const Eigen::Vector3d& p) {
-    n += 1;
-    sum += p;
-    outer += p * p.transpose();
+  void Add(const Eigen::Vector3d& p, double sigma) {
+    const double w = 1.0 / (sigma * sigma);
+    n += w;
+    sum += w * p;
+    outer += w * p * p.transpose();
   }
-  // Normal (towards the camera at the origin) and distance of the best plane; the smallest eigenvalue of the
-  // covariance is the mean squared residual.
-  void Fit(Eigen::Vector3d* normal, double* distance, double* mse = nullptr) const {
+  // Normal (towards the camera at the origin) and distance of the best plane.
+  void Fit(Eigen::Vector3d* normal, double* distance) const {
     const Eigen::Vector3d mean = sum / n;
     const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -53,7 +56,6 @@ struct PlaneAccumulator {
     if (nrm.dot(mean) > 0) nrm = -nrm;
     *normal = nrm;
     *distance = -nrm.dot(mean);
-    if (mse) *mse = std::max(0.0, eig.eigenvalues()(0));
   }
 };
 
@@ -199,7 +201,7 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
     local_residual[i] = std::sqrt(std::max(0.0, eig.eigenvalues()(0))) / sigma[i];
   }
 
-  // 3. Region growing from the flattest seeds.
+  // 3. Region growing from the flattest seeds. Regions too small to keep give their pixels back.
   std::vector<int> order;
   for (int i = 0; i < n_pixels; ++i) {
     if (local_residual[i] >= 0 && local_residual[i] < o.seed_max_residual) order.push_back(i);
@@ -208,42 +210,41 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
                    [&](int a, int b) { return local_residual[a] < local_residual[b]; });
   const double cos_max = std::cos(o.max_normal_angle_deg * M_PI / 180.0);
   const int min_plane_pixels = static_cast<int>(o.min_plane_fraction * n_pixels);
+  const int offsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  auto residual_of = [&](int q, const DepthPlane& plane) {
+    return std::abs(plane.normal.dot(points[q]) + plane.distance) / sigma[q];
+  };
   std::vector<int> label(n_pixels, -1);
   std::vector<uint8_t> seeded(n_pixels, 0);
-  std::vector<DepthPlane> planes;
-  std::vector<int> region, queue;
-  const int offsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-  auto inlier = [&](int q, const Eigen::Vector3d& normal, double distance) {
-    return std::abs(normal.dot(points[q]) + distance) < o.inlier_sigmas * sigma[q];
-  };
+  std::vector<DepthPlane> regions;  // the fit that grew each region
+  std::vector<int> region;
   for (int seed : order) {
     if (label[seed] >= 0 || seeded[seed]) continue;
-    const int id = static_cast<int>(planes.size());
-    Eigen::Vector3d normal = local_normal[seed];
-    double distance = -normal.dot(points[seed]);
+    const int id = static_cast<int>(regions.size());
+    DepthPlane plane;
+    plane.normal = local_normal[seed];
+    plane.distance = -plane.normal.dot(points[seed]);
     PlaneAccumulator acc;
     region.assign(1, seed);
-    queue.assign(1, seed);
     label[seed] = id;
-    acc.Add(points[seed]);
+    acc.Add(points[seed], sigma[seed]);
     size_t next_refit = 32;
-    for (size_t head = 0; head < queue.size(); ++head) {
-      const int p = queue[head];
+    for (size_t head = 0; head < region.size(); ++head) {
+      const int p = region[head];
       const int px = p % w, py = p / w;
       for (const auto& d : offsets) {
         const int qx = px + d[0], qy = py + d[1];
         if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
         const int q = qy * w + qx;
         if (label[q] >= 0 || !valid[q]) continue;
-        if (local_residual[q] < 0 || local_normal[q].dot(normal) < cos_max) continue;
-        if (!inlier(q, normal, distance)) continue;
+        if (local_residual[q] < 0 || local_normal[q].dot(plane.normal) < cos_max) continue;
+        if (residual_of(q, plane) >= o.inlier_sigmas) continue;
         label[q] = id;
         region.push_back(q);
-        queue.push_back(q);
-        acc.Add(points[q]);
+        acc.Add(points[q], sigma[q]);
       }
       if (region.size() >= next_refit) {
-        acc.Fit(&normal, &distance);
+        acc.Fit(&plane.normal, &plane.distance);
         next_refit *= 2;
       }
     }
@@ -252,49 +253,121 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
       for (int q : region) label[q] = -1;
       continue;
     }
-    // The final fit, then the pixels along the edge whose windows straddled it: distance test only,
-    // out to the window radius.
-    acc.Fit(&normal, &distance);
-    std::vector<int> frontier = region;
-    for (int ring = 0; ring <= r && !frontier.empty(); ++ring) {
-      std::vector<int> next;
-      for (int p : frontier) {
-        const int px = p % w, py = p / w;
-        for (const auto& d : offsets) {
-          const int qx = px + d[0], qy = py + d[1];
-          if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-          const int q = qy * w + qx;
-          if (label[q] >= 0 || !valid[q] || !inlier(q, normal, distance)) continue;
-          label[q] = id;
-          region.push_back(q);
-          next.push_back(q);
-        }
+    acc.Fit(&plane.normal, &plane.distance);
+    regions.push_back(plane);
+  }
+
+  // 4. Pixels along the regions' edges, whose windows straddled an edge and so failed the normal test: ring by
+  // ring out to the window radius, each goes to the neighbouring region it fits best, by distance alone.
+  for (int ring = 0; ring <= r; ++ring) {
+    std::vector<std::pair<int, int>> claims;
+    for (int q = 0; q < n_pixels; ++q) {
+      if (label[q] >= 0 || !valid[q]) continue;
+      const int qx = q % w, qy = q / w;
+      int best = -1;
+      double best_residual = o.inlier_sigmas;
+      for (const auto& d : offsets) {
+        const int px = qx + d[0], py = qy + d[1];
+        if (px < 0 || py < 0 || px >= w || py >= h) continue;
+        const int id = label[py * w + px];
+        if (id < 0 || id == best) continue;
+        const double residual = residual_of(q, regions[id]);
+        if (residual < best_residual) best = id, best_residual = residual;
       }
-      frontier.swap(next);
+      if (best >= 0) claims.emplace_back(q, best);
     }
-    PlaneAccumulator final_acc;
-    for (int q : region) final_acc.Add(points[q]);
+    if (claims.empty()) break;
+    for (const auto& [q, id] : claims) label[q] = id;
+  }
+
+  // 5. Regions of one surface that growth split (depth sensors bend large planes a little) are merged: their
+  // normals agree within `merge_angle_deg` and most pixels along their seam fit both planes (a step, such
+  // as a keyboard on a desk, does not).
+  const int n_regions = static_cast<int>(regions.size());
+  std::vector<int> seam(n_regions * n_regions, 0), seam_fit(n_regions * n_regions, 0);
+  for (int p = 0; p < n_pixels; ++p) {
+    if (label[p] < 0) continue;
+    const int px = p % w, py = p / w;
+    for (const int q : {px + 1 < w ? p + 1 : -1, py + 1 < h ? p + w : -1}) {
+      if (q < 0 || label[q] < 0 || label[q] == label[p]) continue;
+      const int a = std::min(label[p], label[q]), b = std::max(label[p], label[q]);
+      ++seam[a * n_regions + b];
+      const bool fits = std::max({residual_of(p, regions[label[q]]), residual_of(q, regions[label[p]])}) <
+                        o.inlier_sigmas;
+      seam_fit[a * n_regions + b] += fits;
+    }
+  }
+  std::vector<int> parent(n_regions);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  const double cos_merge = std::cos(o.merge_angle_deg * M_PI / 180.0);
+  for (int a = 0; a < n_regions; ++a) {
+    for (int b = a + 1; b < n_regions; ++b) {
+      const int n = seam[a * n_regions + b];
+      if (n < 2 * r || seam_fit[a * n_regions + b] < 0.5 * n) continue;
+      if (regions[a].normal.dot(regions[b].normal) < cos_merge) continue;
+      parent[root(b)] = root(a);
+    }
+  }
+
+  // 6. The final fit of each merged region, from pixels whose own windows lie on it: flat, with a local normal
+  // within `merge_angle_deg` of the region's (windows that straddle an edge are neither).
+  std::vector<PlaneAccumulator> flat(n_regions), all(n_regions);
+  for (int q = 0; q < n_pixels; ++q) {
+    if (label[q] < 0) continue;
+    const int grown = label[q];
+    label[q] = root(grown);
+    all[label[q]].Add(points[q], sigma[q]);
+    if (local_residual[q] >= 0 && local_residual[q] < o.nonplanar_residual &&
+        local_normal[q].dot(regions[grown].normal) > cos_merge) {
+      flat[label[q]].Add(points[q], sigma[q]);
+    }
+  }
+  std::vector<DepthPlane> planes;
+  std::vector<int> plane_of(n_regions, -1);
+  for (int id = 0; id < n_regions; ++id) {
+    if (root(id) != id) continue;
     DepthPlane plane;
-    final_acc.Fit(&plane.normal, &plane.distance);
-    double sq = 0;
-    for (int q : region) {
-      const double e = (plane.normal.dot(points[q]) + plane.distance) / sigma[q];
-      sq += e * e;
-    }
-    plane.rms_sigmas = std::sqrt(sq / static_cast<double>(region.size()));
+    (flat[id].n > 0 ? flat[id] : all[id]).Fit(&plane.normal, &plane.distance);
     plane.mask = cv::Mat(h, w, CV_8U, cv::Scalar(0));
-    for (int q : region) plane.mask.at<uchar>(q) = 255;
+    plane_of[id] = static_cast<int>(planes.size());
     planes.push_back(std::move(plane));
+  }
+  std::vector<double> squares(planes.size(), 0);
+  for (int q = 0; q < n_pixels; ++q) {
+    if (label[q] < 0) continue;
+    DepthPlane& plane = planes[plane_of[label[q]]];
+    plane.mask.at<uchar>(q) = 255;
+    const double e = residual_of(q, plane);
+    squares[plane_of[label[q]]] += e * e;
+  }
+  for (size_t i = 0; i < planes.size(); ++i) {
+    planes[i].rms_sigmas = std::sqrt(squares[i] / std::max(1, cv::countNonZero(planes[i].mask)));
   }
   std::stable_sort(planes.begin(), planes.end(), [](const DepthPlane& a, const DepthPlane& b) {
     return cv::countNonZero(a.mask) > cv::countNonZero(b.mask);
   });
 
-  // 4. Clearly non-planar pixels: a high local residual, away from every plane.
+  // 7. Clearly non-planar pixels, away from every plane: rough at the window's scale, or with local normals
+  // that disagree over a window twice as wide.
   if (nonplanar_mask) {
+    cv::Mat normals(h, w, CV_64FC4, cv::Scalar::all(0));
+    for (int i = 0; i < n_pixels; ++i) {
+      if (local_residual[i] < 0) continue;
+      normals.at<cv::Vec4d>(i) = cv::Vec4d(local_normal[i].x(), local_normal[i].y(), local_normal[i].z(), 1.0);
+    }
+    cv::Mat normal_sums;
+    cv::boxFilter(normals, normal_sums, CV_64F, cv::Size(4 * r + 1, 4 * r + 1), cv::Point(-1, -1), false,
+                  cv::BORDER_CONSTANT);
     cv::Mat rough(h, w, CV_8U, cv::Scalar(0));
     for (int i = 0; i < n_pixels; ++i) {
-      if (local_residual[i] > o.nonplanar_residual && label[i] < 0) rough.at<uchar>(i) = 255;
+      if (local_residual[i] < 0 || label[i] >= 0) continue;
+      const cv::Vec4d& s = normal_sums.at<cv::Vec4d>(i);
+      const double dispersion = 1.0 - std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / s[3];
+      if (local_residual[i] > o.nonplanar_residual || dispersion > o.nonplanar_dispersion) rough.at<uchar>(i) = 255;
     }
     // Opening drops the thin lines along depth edges; closing joins what is left into blobs.
     cv::morphologyEx(rough, rough, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));

@@ -7,12 +7,16 @@
 //  2. Depth noise grows with depth: sigma(z) = a + b (z - z0)^2 (Nguyen, Izadi & Lovell 2012, for Kinect).
 //  3. Region growing from the flattest seeds: a neighbour joins a plane if its point lies within
 //     `inlier_sigmas` sigma(z) of the plane and its local normal within `max_normal_angle_deg`; the plane is
-//     refitted as the region doubles. A final least-squares fit gives the normal; pixels along the region's
-//     edge, whose local windows straddle the edge, are then recovered by the distance test alone.
+//     refitted as the region doubles. Pixels along the regions' edges, whose windows straddle the edge, then
+//     go to the neighbouring plane they fit best. Adjacent regions of one surface (sensors bend large planes
+//     a little, which stops growth) are merged if their normals agree and their seam fits both planes.
+//     A final weighted least-squares fit on pixels with flat windows gives each plane's normal.
 //  4. Regions above `min_plane_fraction` of the image become polygons: small holes are filled, larger ones
 //     are joined to the outside by a narrow cut (a "keyhole") so that the polygon leaves them out.
-//  5. Pixels whose local residual exceeds `nonplanar_residual` sigma(z), grouped into blobs that keep clear of
-//     the planes, become `non-plane` shapes if large enough.
+//  5. Clearly non-planar pixels, outside every plane: a local residual above `nonplanar_residual` sigma(z)
+//     (rough at the window's scale), or local normals that disagree over a window twice as wide, 1 - |mean
+//     normal| above `nonplanar_dispersion` (bumpy or curved at a larger scale: foliage, round objects).
+//     Grouped into blobs that keep clear of the planes, large ones become `non-plane` shapes.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -35,8 +39,10 @@ struct DepthPlaneOptions {
   double inlier_sigmas = 5.0;          // point-to-plane threshold, in sigma(z)
   double max_normal_angle_deg = 20.0;  // local normal vs plane normal, degrees
   double seed_max_residual = 1.5;      // seeds' local RMS residual, in sigma(z)
+  double merge_angle_deg = 5.0;        // adjacent regions with normals this close may merge, degrees
   double min_plane_fraction = 0.015;   // of the image area
   double nonplanar_residual = 2.5;     // local RMS residual above which a pixel is non-planar, in sigma(z)
+  double nonplanar_dispersion = 0.1;   // 1 - |mean local normal| above which a pixel is non-planar
   double min_nonplane_fraction = 0.02; // of the image area
   double min_hole_fraction = 0.003;    // holes in a region larger than this are cut out, of the image area
   double polygon_epsilon = 1.0;        // px at full resolution (Douglas-Peucker tolerance)
@@ -53,8 +59,10 @@ struct DepthPlaneOptions {
     visit("inlier_sigmas", self.inlier_sigmas);
     visit("max_normal_angle_deg", self.max_normal_angle_deg);
     visit("seed_max_residual", self.seed_max_residual);
+    visit("merge_angle_deg", self.merge_angle_deg);
     visit("min_plane_fraction", self.min_plane_fraction);
     visit("nonplanar_residual", self.nonplanar_residual);
+    visit("nonplanar_dispersion", self.nonplanar_dispersion);
     visit("min_nonplane_fraction", self.min_nonplane_fraction);
     visit("min_hole_fraction", self.min_hole_fraction);
     visit("polygon_epsilon", self.polygon_epsilon);

@@ -1,0 +1,134 @@
+#include "pdvo/annotations/depth_planes.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/common/options.h"
+#include "pdvo/test/scenes.h"
+#include "pdvo/test/support.h"
+
+namespace pdvo {
+namespace {
+
+struct Recovered {
+  double iou = 0, worst_angle_deg = 0;
+};
+
+// For ground-truth plane `id`: the found plane shapes lying mostly on it (an occluder may split a plane into
+// several), the IoU of their union with the plane, and the largest angle between their normals and the truth.
+// Pixels within 10 px of the bush are left out: floor seen through gaps in foliage belongs to the bush's blob.
+Recovered Recover(const Annotation& a, const test::RenderedDepth& truth, int id, const Eigen::Vector3d& normal) {
+  cv::Mat near_bush;
+  cv::dilate(truth.label >= 1000, near_bush, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(21, 21)));
+  const cv::Mat want = (truth.label == id) & ~near_bush;
+  cv::Mat got(want.size(), CV_8U, cv::Scalar(0));
+  Recovered r;
+  for (const AnnotationShape& s : a.shapes) {
+    if (!s.IsPlane()) continue;
+    const cv::Mat mask = RasteriseShape(s, a);
+    if (cv::countNonZero(mask & want) < 0.5 * cv::countNonZero(mask)) continue;
+    got |= mask & ~near_bush;
+    r.worst_angle_deg = std::max(r.worst_angle_deg, std::acos(std::clamp(s.normal->dot(normal), -1.0, 1.0)) * 180 / M_PI);
+  }
+  r.iou = cv::countNonZero(want & got) / static_cast<double>(cv::countNonZero(want | got));
+  return r;
+}
+
+TEST(DepthPlanes, RecoversTheRoomsPlanesAndMarksTheBush) {
+  std::vector<test::ScenePlane> planes;
+  std::vector<test::SceneSphere> spheres;
+  test::RoomScene(&planes, &spheres);
+  const Camera camera = test::SceneCamera();
+  const DepthPlaneOptions options;
+  const test::RenderedDepth truth = test::RenderDepth(camera, planes, spheres, options.noise_a, options.noise_b, 7);
+  const DepthPlaneFinder finder(camera, options);
+  const Annotation a = finder.Annotate(truth.depth, "rgb.png");
+  EXPECT_TRUE(std::none_of(Validate(a).begin(), Validate(a).end(), [](const auto& i) { return i.is_error; }));
+  for (int id = 0; id < 3; ++id) {
+    const Recovered r = Recover(a, truth, id, planes[id].normal);
+    EXPECT_GT(r.iou, 0.9) << "plane " << id << " covers " << cv::countNonZero(truth.label == id) << " px";
+    EXPECT_LT(r.worst_angle_deg, 0.5) << "plane " << id;
+  }
+  // The bush of small spheres is non-planar: mostly covered by non-plane shapes, hardly by planes.
+  const AnnotationMasks m = Rasterise(a);
+  const cv::Mat bush = truth.label >= 1000;
+  EXPECT_GT(cv::countNonZero(bush & (m.label == kMaskNonPlane)), 0.7 * cv::countNonZero(bush));
+  EXPECT_LT(cv::countNonZero(bush & (m.label == kMaskPlane)), 0.05 * cv::countNonZero(bush));
+}
+
+TEST(DepthPlanes, PlaneParametersMatchTheTruthWithoutNoise) {
+  std::vector<test::ScenePlane> planes;
+  std::vector<test::SceneSphere> spheres;
+  test::RoomScene(&planes, &spheres);
+  const Camera camera = test::SceneCamera();
+  const test::RenderedDepth truth = test::RenderDepth(camera, planes, {}, 0, 0, 1);
+  const std::vector<DepthPlane> found = DepthPlaneFinder(camera, {}).FindPlanes(truth.depth);
+  ASSERT_EQ(found.size(), 3u);
+  for (const DepthPlane& f : found) {
+    double best = 1e9;
+    for (const auto& p : planes) best = std::min(best, (f.normal - p.normal).norm() + std::abs(f.distance - p.distance));
+    EXPECT_LT(best, 1e-4);
+  }
+}
+
+TEST(DepthPlanes, EmptyOrWrongDepthIsHandled) {
+  const Camera camera = test::SceneCamera();
+  const DepthPlaneFinder finder(camera, {});
+  const Annotation a = finder.Annotate(cv::Mat(240, 320, CV_32F, cv::Scalar(0)), "x.png");
+  EXPECT_TRUE(a.shapes.empty());
+  EXPECT_THROW(finder.Annotate(cv::Mat(10, 10, CV_32F, cv::Scalar(1)), "x.png"), InvalidArgument);
+  EXPECT_THROW(finder.Annotate(cv::Mat(240, 320, CV_16U, cv::Scalar(1)), "x.png"), InvalidArgument);
+  DepthPlaneOptions bad;
+  bad.max_normal_angle_deg = 95;
+  EXPECT_THROW(DepthPlaneFinder(camera, bad), InvalidArgument);
+}
+
+TEST(DepthPlanes, OptionsRoundTripThroughYaml) {
+  test::TempDir dir;
+  DepthPlaneOptions o;
+  o.inlier_sigmas = 2.5;
+  o.working_width = 160;
+  SaveOptions(dir / "o.yaml", o, "annotate_depth");
+  EXPECT_EQ(LoadOptions<DepthPlaneOptions>(dir / "o.yaml", "annotate_depth"), o);
+  EXPECT_NE(o, DepthPlaneOptions());
+}
+
+TEST(MaskToPolygons, LargeHolesAreCutOutSmallOnesFilled) {
+  cv::Mat mask(100, 100, CV_8U, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(10, 10, 80, 80), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(mask, cv::Rect(30, 40, 30, 30), cv::Scalar(0), cv::FILLED);  // large hole
+  cv::rectangle(mask, cv::Rect(70, 20, 3, 3), cv::Scalar(0), cv::FILLED);    // small hole
+  const auto polygons = MaskToPolygons(mask, 100, 50, 1.0, 0.5);
+  ASSERT_EQ(polygons.size(), 1u);
+  EXPECT_FALSE(PolygonSelfIntersects(polygons[0]));
+  AnnotationShape s;
+  s.label = kPlaneLabel;
+  s.points = polygons[0];
+  Annotation a;
+  a.image_width = a.image_height = 100;
+  const cv::Mat filled = RasteriseShape(s, a);
+  EXPECT_EQ(filled.at<uchar>(55, 45), 0);    // inside the large hole
+  EXPECT_EQ(filled.at<uchar>(21, 71), 255);  // the small hole is filled
+  EXPECT_EQ(filled.at<uchar>(80, 80), 255);
+  // Everything but the large hole and the keyhole cut is covered.
+  EXPECT_NEAR(cv::countNonZero(filled), 80 * 80 - 30 * 30, 80 * 80 * 0.03);
+}
+
+TEST(MaskToPolygons, ScalesToFullResolutionAndDropsSmallRegions) {
+  cv::Mat mask(50, 50, CV_8U, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(10, 10, 20, 20), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(mask, cv::Rect(40, 40, 4, 4), cv::Scalar(255), cv::FILLED);
+  const auto polygons = MaskToPolygons(mask, 50, 10, 2.0, 1.0);
+  ASSERT_EQ(polygons.size(), 1u);
+  // Pixel centres 10..29 at half resolution are 20.5..59.5 at full resolution.
+  double min_x = 1e9, max_x = -1e9;
+  for (const auto& p : polygons[0]) min_x = std::min(min_x, p.x()), max_x = std::max(max_x, p.x());
+  EXPECT_DOUBLE_EQ(min_x, 20.5);
+  EXPECT_DOUBLE_EQ(max_x, 58.5);
+}
+
+}  // namespace
+}  // namespace pdvo
