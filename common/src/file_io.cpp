@@ -49,9 +49,27 @@ std::string ReadFile(const std::string& path) {
   return ss.str();
 }
 
+namespace {
+// A truncated PNG or JPEG is caught here, before the decoder, because libpng and libjpeg report it on stderr
+// themselves. A PNG ends with its IEND chunk, a JPEG with its end-of-image marker (possibly followed by a
+// little padding).
+void CheckNotTruncated(const std::string& path, const std::string& bytes) {
+  static const std::string kPngSignature = "\x89PNG\r\n\x1a\n";
+  const std::string tail = bytes.substr(bytes.size() > 64 ? bytes.size() - 64 : 0);
+  if (bytes.compare(0, kPngSignature.size(), kPngSignature) == 0) {
+    PDVO_THROW_CHECK(tail.find("IEND") != std::string::npos, IoError,
+                     path << ": cannot decode image (truncated PNG: no IEND chunk)");
+  } else if (bytes.size() > 2 && static_cast<uint8_t>(bytes[0]) == 0xFF && static_cast<uint8_t>(bytes[1]) == 0xD8) {
+    PDVO_THROW_CHECK(tail.find("\xFF\xD9") != std::string::npos, IoError,
+                     path << ": cannot decode image (truncated JPEG: no end-of-image marker)");
+  }
+}
+}  // namespace
+
 cv::Mat ReadImage(const std::string& path, int flags) {
   const std::string bytes = ReadFile(path);
   PDVO_THROW_CHECK(!bytes.empty(), IoError, path << ": image file is empty");
+  CheckNotTruncated(path, bytes);
   cv::Mat image;
   try {
     image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,

@@ -1,0 +1,182 @@
+// The `pdvo` command end to end: exit codes, one-line errors that name the file, no partial output.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pdvo/annotations/annotation.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/common/trajectory.h"
+#include "pdvo/test/scenes.h"
+#include "pdvo/test/support.h"
+
+namespace pdvo {
+namespace {
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int code;
+  std::string out, err;
+};
+
+// Runs `pdvo <args>`, capturing stdout and stderr.
+CommandResult Pdvo(const std::string& args, const test::TempDir& dir) {
+  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string command = std::string(PDVO_BINARY) + " " + args + " > " + out + " 2> " + err;
+  const int status = std::system(command.c_str());
+  return {WEXITSTATUS(status), ReadFile(out), ReadFile(err)};
+}
+
+int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+// A TUM-style RGB-D folder of the ray-cast room: 3 frames, camera.yaml.
+void WriteRoomSequence(const std::string& root) {
+  std::vector<test::ScenePlane> planes;
+  std::vector<test::SceneSphere> spheres;
+  test::RoomScene(&planes, &spheres);
+  const Camera camera = test::SceneCamera();
+  fs::create_directories(root + "/rgb");
+  fs::create_directories(root + "/depth");
+  std::string rgb = "# color images\n", depth = "# depth maps\n";
+  for (int i = 0; i < 3; ++i) {
+    const test::RenderedDepth r = test::RenderDepth(camera, planes, spheres, 0.0012, 0.0019, 20 + i);
+    cv::Mat d16, grey;
+    r.depth.convertTo(d16, CV_16U, 5000.0);
+    r.depth.convertTo(grey, CV_8U, 50.0);
+    const std::string name = std::to_string(i);
+    cv::imwrite(root + "/rgb/" + name + ".png", grey);
+    cv::imwrite(root + "/depth/" + name + ".png", d16);
+    rgb += std::to_string(1.0 + i / 30.0) + " rgb/" + name + ".png\n";
+    depth += std::to_string(1.0 + i / 30.0) + " depth/" + name + ".png\n";
+  }
+  WriteFileAtomically(root + "/rgb.txt", rgb);
+  WriteFileAtomically(root + "/depth.txt", depth);
+  camera.Write(root + "/camera.yaml");
+}
+
+TEST(Cli, UsageAndHelp) {
+  test::TempDir dir;
+  EXPECT_EQ(Pdvo("", dir).code, 1);
+  const CommandResult help = Pdvo("--help", dir);
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.out.find("annotate-depth"), std::string::npos);
+  EXPECT_EQ(Pdvo("frobnicate", dir).code, 1);
+  for (const char* command : {"show", "validate", "annotate-depth", "compare", "ate"}) {
+    const CommandResult r = Pdvo(std::string(command) + " --help", dir);
+    EXPECT_EQ(r.code, 0) << command;
+    EXPECT_NE(r.out.find("--verbosity"), std::string::npos) << command;
+  }
+  EXPECT_NE(Pdvo("ate --gt x", dir).code, 0);  // a missing required flag
+}
+
+TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {
+  test::TempDir dir;
+  const auto expect_error = [&](const std::string& args, const std::string& text) {
+    const CommandResult r = Pdvo(args, dir);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(text), std::string::npos) << args << ": " << r.err;
+  };
+  expect_error("show " + (dir / "none.json") + " --out " + (dir / "o.png"), "none.json: file not found");
+  WriteFileAtomically(dir / "bad.json", "{ not json");
+  expect_error("show " + (dir / "bad.json") + " --out " + (dir / "o.png"), "bad.json: malformed JSON");
+
+  // A valid annotation of a truncated image.
+  cv::Mat noise(40, 60, CV_8UC3);
+  cv::randu(noise, 0, 255);
+  WriteImage(dir / "img.png", noise);
+  const std::string png = ReadFile(dir / "img.png");
+  WriteFileAtomically(dir / "img.png", png.substr(0, png.size() / 2));
+  Annotation a;
+  a.image_path = "img.png";
+  a.image_width = 60;
+  a.image_height = 40;
+  AnnotationShape s;
+  s.label = kPlaneLabel;
+  s.points = {{5, 5}, {30, 5}, {30, 30}};
+  s.normal = Eigen::Vector3d(0, 0, -1);
+  a.shapes = {s};
+  WriteAnnotation(dir / "a.json", a);
+  expect_error("show " + (dir / "a.json") + " --out " + (dir / "o.png"), "img.png: cannot decode image");
+  EXPECT_FALSE(fs::exists(dir / "o.png"));
+  // An invalid one: the error names the file and the shape.
+  a.shapes[0].points.pop_back();
+  WriteAnnotation(dir / "b.json", a);
+  expect_error("show " + (dir / "b.json") + " --out " + (dir / "o.png"),
+               "b.json: shape 0 (plane): polygon has 2 distinct points");
+  const CommandResult v = Pdvo("validate " + (dir / "b.json"), dir);
+  EXPECT_EQ(v.code, 2);
+  EXPECT_NE(v.out.find("b.json: shape 0 (plane): polygon has 2 distinct points"), std::string::npos);
+
+  WriteFileAtomically(dir / "empty.txt", "# nothing\n");
+  WriteFileAtomically(dir / "gt.txt", "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n3 2 0 0 0 0 0 1\n");
+  WriteFileAtomically(dir / "back.txt", "1 0 0 0 0 0 0 1\n0.5 1 0 0 0 0 0 1\n");
+  expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "empty.txt"), "empty.txt: contains no poses");
+  expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "back.txt"), "back.txt:2: timestamp 0.5 does not increase");
+  expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "gt.txt") + " --align affine", "unknown alignment");
+
+  WriteRoomSequence(dir / "seq");
+  WriteFileAtomically(dir / "cam.yaml", "%YAML:1.0\nwidth: 320\nheight: 240\nfx: 277\ncx: 159.5\ncy: 119.5\n");
+  expect_error("annotate-depth -s " + (dir / "seq") + " -o " + (dir / "out") + " -c " + (dir / "cam.yaml"),
+               "cam.yaml: missing key 'fy'");
+  expect_error("annotate-depth -s " + (dir / "seq") + " -o " + (dir / "out") + " --set inlier_sigma=3",
+               "unknown option 'inlier_sigma'");
+}
+
+TEST(Cli, AteOfAScaledCopy) {
+  test::TempDir dir;
+  Trajectory gt;
+  for (int i = 0; i < 50; ++i) {
+    gt.push_back({i * 0.1, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.02 * i, 0)), Eigen::Vector3d(std::sin(0.1 * i), 0.05 * i, i * 0.1))});
+  }
+  Trajectory est = gt;
+  for (StampedPose& p : est) p.world_from_cam.translation *= 0.25;
+  WriteTrajectory(dir / "gt.txt", gt, TrajectoryFormat::kTum);
+  WriteTrajectory(dir / "est.txt", est, TrajectoryFormat::kTum);
+  const CommandResult r = Pdvo("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "est.txt") + " --align sim3 --json " +
+                         (dir / "ate.json"),
+                     dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(ReadFile(dir / "ate.json"));
+  EXPECT_NEAR(j["ate"]["scale"].get<double>(), 4.0, 1e-6);
+  EXPECT_LT(j["ate"]["translation"]["rmse"].get<double>(), 1e-6);
+  EXPECT_EQ(j["ate"]["matched"].get<int>(), 50);
+}
+
+TEST(Cli, AnnotateDepthWritesValidAnnotationsAndNothingOnFailure) {
+  test::TempDir dir;
+  WriteRoomSequence(dir / "seq");
+  const CommandResult ok = Pdvo("annotate-depth -s " + (dir / "seq") + " -o " + (dir / "out"), dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  for (const char* name : {"0.json", "1.json", "2.json", "annotate_depth.yaml"}) {
+    EXPECT_TRUE(fs::exists(dir / ("out/" + std::string(name)))) << name;
+  }
+  const Annotation a = ReadAnnotation(dir / "out/1.json");
+  EXPECT_EQ(ResolveImagePath(a, dir / "out/1.json"), fs::path(dir / "seq/rgb/1.png").lexically_normal().string());
+  int planes = 0, non_planes = 0;
+  for (const AnnotationShape& s : a.shapes) (s.IsPlane() ? planes : non_planes)++;
+  EXPECT_GE(planes, 3);
+  EXPECT_GE(non_planes, 1);
+  EXPECT_EQ(Pdvo("validate " + (dir / "out"), dir).code, 0);
+  EXPECT_EQ(Pdvo("show " + (dir / "out/1.json") + " --out " + (dir / "o.png"), dir).code, 0);
+  EXPECT_GE(cv::imread(dir / "o.png").rows, 240);  // the legend may pad short images
+  // Comparing the output with itself: every plane matched with IoU 1.
+  const CommandResult c = Pdvo("compare -r " + (dir / "out") + " -e " + (dir / "out"), dir);
+  EXPECT_EQ(c.code, 0);
+  EXPECT_NE(c.out.find("IoU median 1.000"), std::string::npos) << c.out;
+
+  // A corrupt depth map in the middle: an error naming it, and no partial output in a new folder.
+  WriteFileAtomically(dir / "seq/depth/1.png", "garbage");
+  const CommandResult bad = Pdvo("annotate-depth -s " + (dir / "seq") + " -o " + (dir / "out2"), dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("1.png: cannot decode image"), std::string::npos) << bad.err;
+  EXPECT_TRUE(!fs::exists(dir / "out2") || fs::is_empty(dir / "out2"));
+  // And what the user already had is untouched.
+  EXPECT_EQ(Pdvo("annotate-depth -s " + (dir / "seq") + " -o " + (dir / "out"), dir).code, 2);
+  EXPECT_TRUE(fs::exists(dir / "out/2.json"));
+}
+
+}  // namespace
+}  // namespace pdvo

@@ -1,0 +1,66 @@
+#include "pdvo/eval/plane_match.h"
+
+#include <gtest/gtest.h>
+
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+AnnotationShape Rect(double x0, double y0, double x1, double y1, Eigen::Vector3d normal) {
+  AnnotationShape s;
+  s.label = kPlaneLabel;
+  s.points = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  s.normal = normal.normalized();
+  return s;
+}
+
+Annotation Frame(std::vector<AnnotationShape> shapes) {
+  Annotation a;
+  a.image_width = 200;
+  a.image_height = 100;
+  a.shapes = std::move(shapes);
+  return a;
+}
+
+TEST(PlaneMatch, IouAndNormalAngleOfKnownShapes) {
+  // Reference: two 40x40 squares. Estimate: the first shifted by 20 px (IoU 1/3) and turned by 10 degrees;
+  // the second exact; a third estimate overlaps nothing.
+  const Eigen::Vector3d n(0, 0, -1);
+  const Eigen::Vector3d turned(std::sin(10 * M_PI / 180), 0, -std::cos(10 * M_PI / 180));
+  const Annotation ref = Frame({Rect(0, 0, 39, 39, n), Rect(100, 0, 139, 39, n)});
+  const Annotation est = Frame({Rect(100, 0, 139, 39, n), Rect(20, 0, 59, 39, turned), Rect(0, 60, 30, 90, n)});
+  const PlaneComparison c = ComparePlanes(ref, est);
+  EXPECT_EQ(c.reference_planes, 2);
+  EXPECT_EQ(c.estimated_planes, 3);
+  ASSERT_EQ(c.matches.size(), 2u);
+  EXPECT_EQ(c.matches[0].reference_shape, 1);  // the best pair first
+  EXPECT_EQ(c.matches[0].estimated_shape, 0);
+  EXPECT_NEAR(c.matches[0].iou, 1.0, 1e-12);
+  EXPECT_NEAR(c.matches[0].normal_angle_deg, 0.0, 1e-6);
+  EXPECT_EQ(c.matches[1].reference_shape, 0);
+  EXPECT_NEAR(c.matches[1].iou, 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(c.matches[1].normal_angle_deg, 10.0, 1e-9);
+  const PlaneComparisonSummary s = Summarise({c});
+  EXPECT_EQ(s.matched, 2);
+  EXPECT_NEAR(s.median_iou, (1.0 + 1.0 / 3.0) / 2, 1e-12);
+}
+
+TEST(PlaneMatch, OneToOneAndUnmatchedCountAsZero) {
+  const Eigen::Vector3d n(0, 0, -1);
+  // One estimate covers both references; only one of them may take it.
+  const Annotation ref = Frame({Rect(0, 0, 49, 49, n), Rect(50, 0, 99, 49, n)});
+  const Annotation est = Frame({Rect(0, 0, 99, 49, n)});
+  const PlaneComparison c = ComparePlanes(ref, est);
+  ASSERT_EQ(c.matches.size(), 1u);
+  EXPECT_NEAR(c.matches[0].iou, 0.5, 1e-12);
+  const PlaneComparisonSummary s = Summarise({c});
+  EXPECT_EQ(s.reference_planes, 2);
+  EXPECT_NEAR(s.median_iou, 0.25, 1e-12);  // median of {0.5, 0}
+  Annotation other = est;
+  other.image_width = 300;
+  EXPECT_THROW(ComparePlanes(ref, other), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo
