@@ -132,3 +132,14 @@ TEST(MaskToPolygons, ScalesToFullResolutionAndDropsSmallRegions) {
 
 }  // namespace
 }  // namespace pdvo
+
+namespace pdvo {
+namespace {
+
+TEST(DepthPlanes, ShippedDefaultConfigEqualsTheDefaults) {
+  EXPECT_EQ(LoadOptions<DepthPlaneOptions>(PDVO_SOURCE_DIR "/annotations/config/default.yaml", "annotate_depth"),
+            DepthPlaneOptions());
+}
+
+}  // namespace
+}  // namespace pdvo
