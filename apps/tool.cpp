@@ -1,5 +1,7 @@
 #include "tool.h"
 
+#include <opencv2/core/utils/logger.hpp>
+
 #include "pdvo/common/logging.h"
 
 namespace pdvo::apps {
@@ -9,6 +11,12 @@ void AddVerbosityFlag(CLI::App& app, std::string* verbosity) {
       ->capture_default_str();
 }
 
-void ApplyVerbosity(const std::string& verbosity) { SetLogLevel(ParseLogLevel(verbosity)); }
+void ApplyVerbosity(const std::string& verbosity) {
+  const LogLevel level = ParseLogLevel(verbosity);
+  SetLogLevel(level);
+  // OpenCV's own messages would break the one-line errors; they are shown only when debugging.
+  cv::utils::logging::setLogLevel(level == LogLevel::kDebug ? cv::utils::logging::LOG_LEVEL_WARNING
+                                                           : cv::utils::logging::LOG_LEVEL_SILENT);
+}
 
 }  // namespace pdvo::apps

@@ -221,7 +221,9 @@ std::unique_ptr<Sequence> OpenImageFolder(const fs::path& root, const SequenceOp
 class VideoSequence : public Sequence {
  public:
   VideoSequence(const std::string& path, double fps) : path_(path) {
-    capture_.open(path);
+    // FFmpeg decodes video files; other backends (GStreamer, image sequences) print noise for files they
+    // cannot open.
+    capture_.open(path, cv::CAP_FFMPEG);
     PDVO_THROW_CHECK(capture_.isOpened(), IoError, path << ": cannot open as a video");
     const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
     count_ = count > 0 ? static_cast<size_t>(count) : 0;
