@@ -133,21 +133,18 @@ std::unique_ptr<Sequence> OpenTum(const fs::path& root, const SequenceOptions& o
 std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
   // calib.txt: lines of 12 numbers, optionally labelled "P0:"; the first is the left camera.
   const std::string calib_path = (root / "calib.txt").string();
-  std::istringstream calib(ReadFile(calib_path));
-  std::string label;
   std::vector<double> p0;
-  std::string line;
-  while (std::getline(calib, line) && p0.empty()) {
+  for (const auto& [number, line] : ReadDataLines(calib_path)) {
     std::istringstream fields(line);
     std::string token;
-    std::vector<double> values;
     while (fields >> token) {
-      if (token.back() == ':') continue;
+      if (token.back() == ':') continue;  // a "P0:" label
       char* end = nullptr;
-      values.push_back(std::strtod(token.c_str(), &end));
-      PDVO_THROW_CHECK(end && *end == '\0', FormatError, calib_path << ": '" << token << "' is not a number");
+      p0.push_back(std::strtod(token.c_str(), &end));
+      PDVO_THROW_CHECK(end && *end == '\0', FormatError,
+                       calib_path << ":" << number << ": '" << token << "' is not a number");
     }
-    if (!values.empty()) p0 = values;
+    break;  // the first line is the left camera
   }
   PDVO_THROW_CHECK(p0.size() == 12, FormatError,
                    calib_path << ": expected a 3x4 projection matrix (12 numbers) on the first line");
@@ -262,14 +259,8 @@ class VideoSequence : public Sequence {
 }  // namespace
 
 std::vector<std::pair<double, std::string>> ReadTumList(const std::string& path) {
-  std::istringstream in(ReadFile(path));
   std::vector<std::pair<double, std::string>> list;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
+  for (const auto& [number, line] : ReadDataLines(path)) {
     std::istringstream fields(line);
     double t = 0;
     std::string file;

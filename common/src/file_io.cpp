@@ -49,6 +49,17 @@ std::string ReadFile(const std::string& path) {
   return ss.str();
 }
 
+std::vector<std::pair<int, std::string>> ReadDataLines(const std::string& path) {
+  std::istringstream in(ReadFile(path));
+  std::vector<std::pair<int, std::string>> lines;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string::npos && line[first] != '#') lines.emplace_back(number, line);
+  }
+  return lines;
+}
+
 namespace {
 // A truncated PNG or JPEG is caught here, before the decoder, because libpng and libjpeg report it on stderr
 // themselves. A PNG ends with its IEND chunk, a JPEG with its end-of-image marker (possibly followed by a

@@ -18,15 +18,8 @@ struct Row {
 };
 
 std::vector<Row> ReadNumericRows(const std::string& path, size_t columns) {
-  const std::string content = ReadFile(path);
   std::vector<Row> rows;
-  std::istringstream in(content);
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
+  for (const auto& [number, line] : ReadDataLines(path)) {
     std::istringstream fields(line);
     Row row{number, {}};
     std::string token;

@@ -13,17 +13,8 @@
 namespace pdvo {
 namespace {
 
-Camera TumFr1() {
-  Camera c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = 517.3;
-  c.fy = 516.5;
-  c.cx = 318.6;
-  c.cy = 255.3;
-  c.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
-  return c;
-}
+// The shipped camera file of the TUM Freiburg 1 sequences.
+Camera TumFr1() { return Camera::Read(PDVO_SOURCE_DIR "/config/cameras/tum_fr1.yaml"); }
 
 TEST(Camera, YamlRoundTrip) {
   test::TempDir dir;

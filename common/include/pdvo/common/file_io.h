@@ -4,6 +4,8 @@
 
 #include <opencv2/core/mat.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace pdvo {
 
@@ -13,6 +15,10 @@ void WriteFileAtomically(const std::string& path, const std::string& content);
 
 // Reads a whole file; throws IoError naming the file if it is missing or unreadable.
 std::string ReadFile(const std::string& path);
+
+// The lines of a text file that hold data: blank lines and lines starting with '#' are skipped. Each comes
+// with its 1-based line number, for error messages.
+std::vector<std::pair<int, std::string>> ReadDataLines(const std::string& path);
 
 // Reads an image (cv::IMREAD_* flags); throws IoError naming the file if it is missing, empty or cannot be
 // decoded (e.g. truncated).
