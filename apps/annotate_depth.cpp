@@ -32,7 +32,7 @@ int RunAnnotateDepth(int argc, char** argv) {
   app.add_option("--reference", reference_dir, "Folder of reference annotations to compare with");
   app.add_option("--json", json_path, "Write the comparison report (needs --reference) as JSON");
   AddVerbosityFlag(app, &verbosity);
-  CLI11_PARSE(app, argc, argv);
+  PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
   PDVO_THROW_CHECK(json_path.empty() || !reference_dir.empty(), InvalidArgument, "--json needs --reference");
   if (!reference_dir.empty()) CheckExists(reference_dir, "reference folder");

@@ -30,7 +30,7 @@ int RunAte(int argc, char** argv) {
   app.add_option("--rpe-unit", rpe_unit, "RPE: delta in frames or seconds")->capture_default_str();
   app.add_option("--json", json_path, "Write the results as JSON");
   AddVerbosityFlag(app, &verbosity);
-  CLI11_PARSE(app, argc, argv);
+  PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
   PDVO_THROW_CHECK(rpe_unit == "frames" || rpe_unit == "seconds", InvalidArgument,
                    "--rpe-unit must be frames or seconds, got '" << rpe_unit << "'");

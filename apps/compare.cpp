@@ -24,7 +24,7 @@ int RunCompare(int argc, char** argv) {
   app.add_option("--min-iou", options.min_iou, "Pairs below this IoU are not matched")->capture_default_str();
   app.add_option("--json", json_path, "Write the per-frame report as JSON");
   AddVerbosityFlag(app, &verbosity);
-  CLI11_PARSE(app, argc, argv);
+  PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
   CheckExists(estimate_dir, "estimate folder");
 

@@ -22,7 +22,7 @@ int RunShow(int argc, char** argv) {
   app.add_option("--alpha", options.alpha, "Opacity of the tint, 0-1")->capture_default_str();
   app.add_flag("!--no-legend", options.legend, "Leave out the legend panel");
   AddVerbosityFlag(app, &verbosity);
-  CLI11_PARSE(app, argc, argv);
+  PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
   const Annotation annotation = ReadAnnotation(annotation_path);

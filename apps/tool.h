@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,19 @@ namespace pdvo::apps {
 // Adds --verbosity (error, warning, info, debug) to a subcommand; call ApplyVerbosity after parsing.
 void AddVerbosityFlag(CLI::App& app, std::string* verbosity);
 void ApplyVerbosity(const std::string& verbosity);
+
+// Parses a subcommand's flags: --help prints and returns 0; a usage error is one line and returns 1.
+#define PDVO_PARSE_FLAGS(app, argc, argv)                                                          \
+  do {                                                                                             \
+    try {                                                                                          \
+      (app).parse((argc), (argv));                                                                 \
+    } catch (const CLI::CallForHelp& e) {                                                          \
+      return (app).exit(e);                                                                        \
+    } catch (const CLI::ParseError& e) {                                                           \
+      std::cerr << (app).get_name() << ": error: " << e.what() << " (see --help)\n";               \
+      return 1;                                                                                    \
+    }                                                                                              \
+  } while (false)
 
 // Subcommands: each parses its own flags, returns 0 on success and throws pdvo::Error on failure.
 int RunShow(int argc, char** argv);

@@ -38,7 +38,7 @@ int RunValidate(int argc, char** argv) {
   std::string verbosity = "info";
   app.add_option("inputs", inputs, "Annotation files or folders of them")->required();
   AddVerbosityFlag(app, &verbosity);
-  CLI11_PARSE(app, argc, argv);
+  PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
   int errors = 0, warnings = 0;

@@ -59,11 +59,6 @@ struct PlaneAccumulator {
   }
 };
 
-struct LocalFits {
-  cv::Mat normal;    // CV_64FC3, 0 where unknown
-  cv::Mat residual;  // CV_64F, local RMS residual in sigma(z); -1 where unknown
-};
-
 double Sigma(const DepthPlaneOptions& o, double z) {
   const double dz = z - o.noise_z0;
   return o.noise_a + o.noise_b * dz * dz;
@@ -129,7 +124,6 @@ DepthPlaneFinder::DepthPlaneFinder(const Camera& camera, const DepthPlaneOptions
   CheckOptionsOrThrow(options, "annotate-depth options");
   const int w = std::min(options.working_width, camera.width);
   const int h = static_cast<int>(std::lround(static_cast<double>(camera.height) * w / camera.width));
-  working_ = camera.Undistorted().Rescaled(w, h);
   source_x_.create(h, w, CV_32S);
   source_y_.create(h, w, CV_32S);
   ray_x_.create(h, w, CV_64F);

@@ -68,7 +68,10 @@ TEST(Cli, UsageAndHelp) {
     EXPECT_EQ(r.code, 0) << command;
     EXPECT_NE(r.out.find("--verbosity"), std::string::npos) << command;
   }
-  EXPECT_NE(Pdvo("ate --gt x", dir).code, 0);  // a missing required flag
+  const CommandResult missing = Pdvo("ate --gt x", dir);  // a missing required flag
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_EQ(Lines(missing.err), 1) << missing.err;
+  EXPECT_NE(missing.err.find("pdvo ate: error: --est is required"), std::string::npos) << missing.err;
 }
 
 TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {

@@ -92,10 +92,11 @@ class DepthPlaneFinder {
   // The annotation of one frame: planes, then non-planes. `image_path` is written as the imagePath.
   Annotation Annotate(const cv::Mat& depth, const std::string& image_path) const;
 
-  cv::Size working_size() const { return working_.width > 0 ? cv::Size(working_.width, working_.height) : cv::Size(); }
+  // The resolution the depth is processed at.
+  cv::Size working_size() const { return ray_x_.size(); }
 
  private:
-  Camera camera_, working_;
+  Camera camera_;
   DepthPlaneOptions options_;
   cv::Mat source_x_, source_y_;  // CV_32S: the full-resolution pixel each working pixel samples
   cv::Mat ray_x_, ray_y_;        // CV_64F: its viewing ray (x, y, 1)
