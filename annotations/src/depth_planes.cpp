@@ -64,59 +64,7 @@ double Sigma(const DepthPlaneOptions& o, double z) {
   return o.noise_a + o.noise_b * dz * dz;
 }
 
-void FillSmallHolesAndCutLargeOnes(cv::Mat& mask, int min_hole_pixels) {
-  std::vector<std::vector<cv::Point>> contours;
-  std::vector<cv::Vec4i> hierarchy;
-  cv::findContours(mask.clone(), contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
-  for (size_t i = 0; i < contours.size(); ++i) {
-    if (hierarchy[i][3] < 0) continue;  // an outer boundary, not a hole
-    // The hole's area in pixels: its contour runs through the region pixels around it.
-    cv::Mat hole(mask.size(), CV_8U, cv::Scalar(0));
-    cv::drawContours(hole, contours, static_cast<int>(i), cv::Scalar(255), cv::FILLED);
-    hole &= ~mask;
-    if (cv::countNonZero(hole) < min_hole_pixels) {
-      mask |= hole;
-      continue;
-    }
-    // A keyhole: a cut two pixels wide from the hole's top straight up, until it leaves the region.
-    const auto top = std::min_element(contours[i].begin(), contours[i].end(),
-                                      [](const cv::Point& a, const cv::Point& b) { return a.y < b.y; });
-    const int x = std::clamp(top->x, 0, mask.cols - 2);
-    for (int y = top->y; y >= 0; --y) {
-      if (mask.at<uchar>(y, x) == 0 && mask.at<uchar>(y, x + 1) == 0 && y < top->y) break;
-      mask.at<uchar>(y, x) = 0;
-      mask.at<uchar>(y, x + 1) = 0;
-    }
-  }
-}
-
 }  // namespace
-
-std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask_in, int min_pixels, int min_hole_pixels,
-                                                         double scale, double epsilon_full_px) {
-  cv::Mat mask = mask_in > 0;
-  // Opening removes one-pixel necks and spurs, whose contours would touch themselves.
-  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  FillSmallHolesAndCutLargeOnes(mask, min_hole_pixels);
-  std::vector<std::vector<Eigen::Vector2d>> polygons;
-  std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  for (const auto& contour : contours) {
-    if (cv::contourArea(contour) < min_pixels) continue;
-    // Try the requested tolerance, then finer ones, until the polygon does not cross itself.
-    for (double eps = epsilon_full_px / scale; eps >= 0.05; eps *= 0.5) {
-      std::vector<cv::Point> simple;
-      cv::approxPolyDP(contour, simple, eps, true);
-      std::vector<Eigen::Vector2d> polygon;
-      for (const cv::Point& p : simple) polygon.emplace_back((p.x + 0.5) * scale - 0.5, (p.y + 0.5) * scale - 0.5);
-      if (polygon.size() >= 3 && !PolygonSelfIntersects(polygon)) {
-        polygons.push_back(std::move(polygon));
-        break;
-      }
-    }
-  }
-  return polygons;
-}
 
 DepthPlaneFinder::DepthPlaneFinder(const Camera& camera, const DepthPlaneOptions& options)
     : camera_(camera), options_(options) {
@@ -375,52 +323,17 @@ Annotation DepthPlaneFinder::Annotate(const cv::Mat& depth, const std::string& i
   cv::Mat nonplanar;
   const std::vector<DepthPlane> planes = FindPlanes(depth, &nonplanar);
   const int n_pixels = ray_x_.cols * ray_x_.rows;
-  const double scale = static_cast<double>(camera_.width) / ray_x_.cols;
-  const int min_hole = std::max(4, static_cast<int>(options_.min_hole_fraction * n_pixels));
-
+  MaskPolygonOptions polygons;
+  polygons.min_plane_pixels = static_cast<int>(options_.min_plane_fraction * n_pixels);
+  polygons.min_nonplane_pixels = static_cast<int>(options_.min_nonplane_fraction * n_pixels);
+  polygons.min_hole_pixels = std::max(4, static_cast<int>(options_.min_hole_fraction * n_pixels));
+  polygons.epsilon_full_px = options_.polygon_epsilon;
   Annotation a;
   a.image_path = image_path;
   a.image_width = camera_.width;
   a.image_height = camera_.height;
   a.camera = AnnotationCamera{camera_.fx, camera_.fy, camera_.cx, camera_.cy};
-  cv::Mat covered(ray_x_.rows, ray_x_.cols, CV_8U, cv::Scalar(0));
-  for (const DepthPlane& plane : planes) {
-    for (auto& polygon : MaskToPolygons(plane.mask, static_cast<int>(options_.min_plane_fraction * n_pixels),
-                                        min_hole, scale, options_.polygon_epsilon)) {
-      AnnotationShape shape;
-      shape.label = kPlaneLabel;
-      shape.points = std::move(polygon);
-      shape.normal = plane.normal;
-      a.shapes.push_back(std::move(shape));
-      cv::Mat filled = RasteriseShape(a.shapes.back(), a, covered.size());
-      covered |= filled;
-    }
-  }
-  // Non-planes keep a margin from the planes' polygons, so that no region of one label overlaps the other.
-  const int margin = 2 + static_cast<int>(std::ceil(2 * options_.polygon_epsilon / scale));
-  cv::dilate(covered, covered, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
-  nonplanar &= ~covered;
-  for (auto& polygon : MaskToPolygons(nonplanar, static_cast<int>(options_.min_nonplane_fraction * n_pixels),
-                                      min_hole, scale, options_.polygon_epsilon)) {
-    AnnotationShape shape;
-    shape.label = kNonPlaneLabel;
-    shape.points = std::move(polygon);
-    a.shapes.push_back(std::move(shape));
-  }
-  // Anything that still breaks the format's rules (it should not) is dropped rather than written.
-  std::vector<bool> drop(a.shapes.size(), false);
-  for (const ValidationIssue& issue : Validate(a)) {
-    if (issue.is_error && issue.shape >= 0) drop[issue.shape] = true;
-  }
-  std::vector<AnnotationShape> kept;
-  for (size_t i = 0; i < a.shapes.size(); ++i) {
-    if (!drop[i]) {
-      kept.push_back(std::move(a.shapes[i]));
-    } else {
-      PDVO_LOG(Debug) << image_path << ": dropped shape " << i << " that broke the format's rules";
-    }
-  }
-  a.shapes = std::move(kept);
+  AddShapesFromMasks(std::vector<PlaneMask>(planes.begin(), planes.end()), nonplanar, polygons, &a);
   return a;
 }
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "pdvo/annotations/annotation.h"
+#include "pdvo/annotations/mask_polygons.h"
 #include "pdvo/common/camera.h"
 
 namespace pdvo {
@@ -71,10 +72,9 @@ struct DepthPlaneOptions {
   bool operator==(const DepthPlaneOptions&) const = default;
 };
 
-// A plane found in a depth map, at working resolution.
-struct DepthPlane {
-  cv::Mat mask;              // CV_8U, 255 on the plane's pixels
-  Eigen::Vector3d normal;    // unit, camera frame, towards the camera
+// A plane found in a depth map: its mask (at working resolution) and unit normal (camera frame, towards the
+// camera), with the plane's offset and fit quality.
+struct DepthPlane : PlaneMask {
   double distance = 0;       // m; the plane is normal . x + distance = 0 (distance > 0)
   double rms_sigmas = 0;     // RMS point-to-plane residual, in sigma(z)
 };
@@ -101,11 +101,5 @@ class DepthPlaneFinder {
   cv::Mat source_x_, source_y_;  // CV_32S: the full-resolution pixel each working pixel samples
   cv::Mat ray_x_, ray_y_;        // CV_64F: its viewing ray (x, y, 1)
 };
-
-// Polygons (full-resolution pixel coordinates) of the connected regions of `mask` larger than `min_pixels`:
-// holes larger than `min_hole_pixels` are cut out with keyholes, smaller ones filled. `mask` is at
-// working resolution; `scale` = full width / working width.
-std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask, int min_pixels, int min_hole_pixels,
-                                                         double scale, double epsilon_full_px);
 
 }  // namespace pdvo
