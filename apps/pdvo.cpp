@@ -21,6 +21,7 @@ constexpr Command kCommands[] = {
     {"validate", pdvo::apps::RunValidate, "check annotation files against the format's rules"},
     {"annotate-depth", pdvo::apps::RunAnnotateDepth, "find planes in RGB-D depth maps and write annotations"},
     {"compare", pdvo::apps::RunCompare, "match estimated planes to reference annotations: IoU, normal angle"},
+    {"synth", pdvo::apps::RunSynth, "render a synthetic urban street sequence with exact ground truth"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
 };
 

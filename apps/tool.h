@@ -31,5 +31,6 @@ int RunValidate(int argc, char** argv);
 int RunAnnotateDepth(int argc, char** argv);
 int RunCompare(int argc, char** argv);
 int RunAte(int argc, char** argv);
+int RunSynth(int argc, char** argv);
 
 }  // namespace pdvo::apps

@@ -41,7 +41,8 @@ Camera Camera::Read(const cv::FileNode& node, const std::string& where) {
   c.fy = ReadNumber(node, "fy", where, true, 0);
   c.cx = ReadNumber(node, "cx", where, true, 0);
   c.cy = ReadNumber(node, "cy", where, true, 0);
-  std::set<std::string> known = {"width", "height", "fx", "fy", "cx", "cy"};
+  c.depth_scale = ReadNumber(node, "depth_scale", where, false, 0.0);
+  std::set<std::string> known = {"width", "height", "fx", "fy", "cx", "cy", "depth_scale"};
   for (int i = 0; i < 5; ++i) {
     c.distortion[i] = ReadNumber(node, kDistortionKeys[i], where, false, 0.0);
     known.insert(kDistortionKeys[i]);
@@ -61,6 +62,7 @@ void Camera::Write(cv::FileStorage& fs) const {
   fs << "camera" << "{" << "width" << width << "height" << height << "fx" << fx << "fy" << fy << "cx" << cx
      << "cy" << cy;
   for (int i = 0; i < 5; ++i) fs << kDistortionKeys[i] << distortion[i];
+  if (depth_scale > 0) fs << "depth_scale" << depth_scale;
   fs << "}";
 }
 
@@ -69,6 +71,8 @@ void Camera::Check(const std::string& where) const {
                    where << ": image size must be positive, got " << width << "x" << height);
   PDVO_THROW_CHECK(std::isfinite(fx) && std::isfinite(fy) && fx > 0 && fy > 0, InvalidArgument,
                    where << ": focal lengths must be positive and finite, got fx=" << fx << " fy=" << fy);
+  PDVO_THROW_CHECK(std::isfinite(depth_scale) && depth_scale >= 0, InvalidArgument,
+                   where << ": depth_scale must be positive, got " << depth_scale);
   PDVO_THROW_CHECK(std::isfinite(cx) && std::isfinite(cy), InvalidArgument,
                    where << ": principal point is not finite");
   for (int i = 0; i < 5; ++i) {

@@ -126,8 +126,9 @@ std::unique_ptr<Sequence> OpenTum(const fs::path& root, const SequenceOptions& o
     PDVO_LOG(Warning) << root.string() << ": " << without_depth
                       << " images have no depth map within " << options.max_association_dt << " s";
   }
-  return std::make_unique<ListedSequence>("TUM RGB-D folder", root.string(), std::move(entries),
-                                          CameraInFolder(root), options.depth_scale);
+  const std::optional<Camera> camera = CameraInFolder(root);
+  const double depth_scale = camera && camera->depth_scale > 0 ? camera->depth_scale : options.depth_scale;
+  return std::make_unique<ListedSequence>("TUM RGB-D folder", root.string(), std::move(entries), camera, depth_scale);
 }
 
 std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {

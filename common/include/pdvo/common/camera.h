@@ -4,6 +4,7 @@
 // y down, z along the optical axis. YAML layout (a map at the root or under `camera:`):
 //   width: 640   height: 480   fx: 517.3   fy: 516.5   cx: 318.6   cy: 255.3
 //   k1: 0.2624   k2: -0.9531   p1: -0.0054   p2: 0.0026   k3: 1.1633     # optional, default 0
+//   depth_scale: 5000   # optional: an RGB-D camera's depth image units per metre
 // Width, height, fx, fy, cx and cy are required; any other key is an error.
 #pragma once
 
@@ -20,6 +21,7 @@ struct Camera {
   int width = 0, height = 0;               // pixels
   double fx = 0, fy = 0, cx = 0, cy = 0;   // pixels
   std::array<double, 5> distortion{};      // k1, k2, p1, p2, k3
+  double depth_scale = 0;                  // depth image units per metre; 0: not given
 
   // Reads from YAML; throws IoError / FormatError naming the file and the missing or bad key.
   static Camera Read(const std::string& path);

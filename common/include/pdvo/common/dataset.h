@@ -33,7 +33,7 @@ struct Frame {
 
 struct SequenceOptions {
   double max_association_dt = 0.02;  // seconds; TUM depth and ground truth association window
-  double depth_scale = 5000.0;       // depth PNG units per metre (TUM convention)
+  double depth_scale = 5000.0;       // depth PNG units per metre (TUM); camera.yaml's depth_scale overrides it
   double fps = 30.0;                 // image folders without times, and videos without time stamps
   std::string times_path;            // image folder: optional file of one time per line
   bool load_depth = true;            // TUM: read depth maps

@@ -1,0 +1,264 @@
+#include "pdvo/sim/synth.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <Eigen/Eigenvalues>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/annotations/depth_planes.h"
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/dataset.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/common/options.h"
+#include "pdvo/eval/plane_match.h"
+#include "pdvo/test/support.h"
+
+namespace pdvo::sim {
+namespace {
+namespace fs = std::filesystem;
+
+struct Scene {
+  SynthOptions options;
+  Camera camera;
+  Street street;
+  Trajectory walk;
+  explicit Scene(uint64_t seed, int frames = 120, bool loop = false) {
+    options.street.loop = loop;
+    camera = options.MakeCamera();
+    street = GenerateStreet(options.street, options.walk.speed * frames / options.walk.fps + 30, seed);
+    walk = WalkStreet(street, options.walk, frames, seed);
+  }
+};
+
+// Reprojects frame a's plane pixels into frame b; where the landing point's four neighbours show the same plane,
+// compares the predicted depth with b's depth there (inverse depth interpolated, which is exact on a plane).
+// Returns the largest error in metres; *compared counts the pixels.
+double ReprojectionError(const Camera& cam, const RenderedFrame& a, const Rigid3d& pose_a, const RenderedFrame& b,
+                         const Rigid3d& pose_b, int* compared) {
+  const Rigid3d b_from_a = pose_b.Inverse() * pose_a;
+  double worst = 0;
+  *compared = 0;
+  for (int v = 0; v < cam.height; v += 2) {
+    for (int u = 0; u < cam.width; u += 2) {
+      const int id = a.id.at<int>(v, u);
+      if (id < 0) continue;
+      const double z = a.depth.at<float>(v, u);
+      const Eigen::Vector3d x = b_from_a * Eigen::Vector3d(z * (u - cam.cx) / cam.fx, z * (v - cam.cy) / cam.fy, z);
+      if (x.z() < 0.1) continue;
+      const double pu = cam.fx * x.x() / x.z() + cam.cx, pv = cam.fy * x.y() / x.z() + cam.cy;
+      const int u0 = static_cast<int>(std::floor(pu)), v0 = static_cast<int>(std::floor(pv));
+      if (u0 < 0 || v0 < 0 || u0 + 1 >= cam.width || v0 + 1 >= cam.height) continue;
+      bool same = true;
+      double inv = 0;
+      const double fu = pu - u0, fv = pv - v0;
+      for (int dv = 0; dv < 2; ++dv) {
+        for (int du = 0; du < 2; ++du) {
+          same = same && b.id.at<int>(v0 + dv, u0 + du) == id;
+          inv += (du ? fu : 1 - fu) * (dv ? fv : 1 - fv) / b.depth.at<float>(v0 + dv, u0 + du);
+        }
+      }
+      if (!same) continue;  // occluded, or at the plane's edge
+      worst = std::max(worst, std::abs(1.0 / inv - x.z()));
+      ++*compared;
+    }
+  }
+  return worst;
+}
+
+TEST(Synth, DepthReprojectsExactlyBetweenFrames) {
+  const Scene s(3);
+  const Renderer renderer(s.street, s.camera, s.options.render, 3);
+  for (const auto& [i, k] : {std::pair{10, 1}, std::pair{10, 15}, std::pair{60, 45}}) {
+    RenderedFrame a, b;
+    renderer.RenderGeometry(s.walk[i].world_from_cam, &a);
+    renderer.RenderGeometry(s.walk[i + k].world_from_cam, &b);
+    int compared = 0;
+    const double worst = ReprojectionError(s.camera, a, s.walk[i].world_from_cam, b, s.walk[i + k].world_from_cam, &compared);
+    EXPECT_GT(compared, 3000) << i << "->" << i + k;
+    EXPECT_LT(worst, 1e-3) << i << "->" << i + k;
+  }
+}
+
+TEST(Synth, AnnotationNormalsAgreeWithNormalsFromDepth) {
+  const Scene s(4);
+  const Renderer renderer(s.street, s.camera, s.options.render, 4);
+  int checked = 0;
+  for (int i : {0, 50, 100}) {
+    RenderedFrame f;
+    const Rigid3d& pose = s.walk[i].world_from_cam;
+    renderer.RenderGeometry(pose, &f);
+    const Annotation a = AnnotateFrame(s.street, f, pose, s.camera, "x.png");
+    ASSERT_TRUE(std::none_of(Validate(a).begin(), Validate(a).end(), [](const auto& issue) { return issue.is_error; }));
+    for (const AnnotationShape& shape : a.shapes) {
+      if (!shape.IsPlane()) continue;
+      const cv::Mat mask = RasteriseShape(shape, a);
+      // The plane under the polygon: the id most of its pixels show.
+      std::map<int, int> votes;
+      for (int p = 0; p < static_cast<int>(mask.total()); ++p) {
+        if (mask.at<uchar>(p)) ++votes[f.id.at<int>(p)];
+      }
+      const int id = std::max_element(votes.begin(), votes.end(), [](auto& x, auto& y) { return x.second < y.second; })->first;
+      ASSERT_GE(id, 0);
+      if (votes[id] < 200) continue;
+      // Least-squares plane through the back-projected depth of those pixels.
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      std::vector<Eigen::Vector3d> points;
+      for (int p = 0; p < static_cast<int>(mask.total()); ++p) {
+        if (!mask.at<uchar>(p) || f.id.at<int>(p) != id) continue;
+        const int u = p % s.camera.width, v = p / s.camera.width;
+        const double z = f.depth.at<float>(p);
+        points.emplace_back(z * (u - s.camera.cx) / s.camera.fx, z * (v - s.camera.cy) / s.camera.fy, z);
+        mean += points.back();
+      }
+      mean /= static_cast<double>(points.size());
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (const auto& x : points) cov += (x - mean) * (x - mean).transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+      Eigen::Vector3d n = eig.eigenvectors().col(0);
+      if (n.dot(mean) > 0) n = -n;
+      const double angle = std::acos(std::clamp(n.dot(*shape.normal), -1.0, 1.0)) * 180 / M_PI;
+      EXPECT_LT(angle, 1.0) << "frame " << i << " plane " << id;
+      EXPECT_LT(shape.normal->dot(mean), 0.0);  // towards the camera
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 15);
+}
+
+TEST(Synth, WalkMovesAtWalkingSpeedAndLoopsClose) {
+  const Scene s(5, 300);
+  const double length = PathLength(s.walk);
+  EXPECT_NEAR(length / s.walk.back().timestamp, 1.4, 0.1);  // bob and sway add a little
+  EXPECT_NEAR(s.walk[1].timestamp - s.walk[0].timestamp, 1 / 30.0, 1e-12);
+  // Round a loop of about 100 m: the walk comes back to where it started.
+  StreetOptions loop_options;
+  loop_options.loop = true;
+  const Street loop = GenerateStreet(loop_options, 100.0, 6);
+  EXPECT_TRUE(loop.loop);
+  const Trajectory walk = WalkStreet(loop, WalkOptions(), 4000, 6);
+  const int lap = static_cast<int>(std::lround(loop.Length() / 1.4 * 30));
+  ASSERT_LT(lap, 4000);
+  EXPECT_LT((walk[lap].world_from_cam.translation - walk[0].world_from_cam.translation).norm(), 0.2);
+}
+
+TEST(Synth, SameSeedSameBytesAndTheTumReaderReadsIt) {
+  test::TempDir dir;
+  SynthOptions options;
+  options.width = 160;
+  options.height = 120;
+  options.render.motion_blur_samples = 2;
+  options.render.exposure_variation = 0.1;
+  WriteSynthSequence(dir / "a", 9, 6, options);
+  WriteSynthSequence(dir / "b", 9, 6, options);
+  WriteSynthSequence(dir / "c", 10, 6, options);
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "a")) {
+    if (!e.is_regular_file()) continue;
+    const fs::path rel = fs::relative(e.path(), dir / "a");
+    EXPECT_EQ(ReadFile(e.path().string()), ReadFile((fs::path(dir / "b") / rel).string())) << rel;
+    ++files;
+  }
+  EXPECT_EQ(files, 6 * 4 + 6);  // rgb, depth, planes, annotation per frame; 6 files per sequence
+  EXPECT_NE(ReadFile(dir / "a/rgb/000003.png"), ReadFile(dir / "c/rgb/000003.png"));
+
+  auto sequence = OpenSequence(dir / "a");
+  ASSERT_TRUE(sequence->camera().has_value());
+  EXPECT_EQ(sequence->camera()->width, 160);
+  const Trajectory gt = ReadTrajectory(dir / "a/groundtruth.txt", TrajectoryFormat::kTum);
+  Frame frame;
+  int n = 0;
+  while (sequence->Next(&frame)) {
+    ASSERT_FALSE(frame.depth.empty());
+    ASSERT_TRUE(frame.world_from_cam.has_value());
+    EXPECT_LT((frame.world_from_cam->translation - gt[n].world_from_cam.translation).norm(), 1e-6);
+    ++n;
+  }
+  EXPECT_EQ(n, 6);
+  EXPECT_TRUE(fs::exists(dir / "a/planes.json"));
+  EXPECT_TRUE(Validate(ReadAnnotation(dir / "a/annotations/000005.json")).empty());
+}
+
+TEST(Synth, DepthFilesReprojectWithinAMillimetre) {
+  test::TempDir dir;
+  SynthOptions options;
+  WriteSynthSequence(dir.str(), 12, 12, options);
+  auto sequence = OpenSequence(dir.str());
+  std::vector<Frame> frames(12);
+  for (Frame& f : frames) ASSERT_TRUE(sequence->Next(&f));
+  const Camera camera = *sequence->camera();
+  RenderedFrame a, b;
+  for (auto [frame, out] : {std::pair{0, &a}, std::pair{11, &b}}) {
+    out->depth = frames[frame].depth;
+    cv::Mat ids = ReadImage(dir / ("planes/" + std::string(frame ? "000011" : "000000") + ".png"), cv::IMREAD_ANYDEPTH);
+    ids.convertTo(out->id, CV_32S, 1, -1);
+    out->id.setTo(-1, out->depth == 0);  // beyond the 16-bit range: unknown
+  }
+  int compared = 0;
+  const double worst = ReprojectionError(camera, a, *frames[0].world_from_cam, b, *frames[11].world_from_cam, &compared);
+  EXPECT_GT(compared, 3000);
+  EXPECT_LT(worst, 1e-3);
+}
+
+TEST(Synth, BadOptionsAreRejected) {
+  test::TempDir dir;
+  SynthOptions options;
+  options.street.max_turn_deg = 120;
+  EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 3, options), InvalidArgument);
+  options = SynthOptions();
+  EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 0, options), InvalidArgument);
+  Camera distorted = options.MakeCamera();
+  distorted.distortion[0] = 0.1;
+  const Scene s(1, 10);
+  EXPECT_THROW(Renderer(s.street, distorted, options.render, 1), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo::sim
+
+namespace pdvo::sim {
+namespace {
+
+// The two parts check each other: annotation from depth, run on a synthetic sequence with the shipped options
+// for its sensor, finds the planes of the exact annotations.
+TEST(Synth, AnnotateDepthRecoversTheStreetsPlanes) {
+  const Scene s(21, 150);
+  const Renderer renderer(s.street, s.camera, s.options.render, 21);
+  const DepthPlaneFinder finder(
+      s.camera, LoadOptions<DepthPlaneOptions>(PDVO_SOURCE_DIR "/annotations/config/synthetic.yaml", "annotate_depth"));
+  std::vector<PlaneComparison> comparisons;
+  std::vector<double> ious;
+  double worst_angle = 0;
+  for (int i = 0; i < 150; i += 15) {
+    RenderedFrame f;
+    renderer.RenderGeometry(s.walk[i].world_from_cam, &f);
+    cv::Mat depth = f.depth.clone();
+    depth.setTo(0, depth > 65535 / kSynthDepthScale);  // as stored
+    const PlaneComparison c =
+        ComparePlanes(AnnotateFrame(s.street, f, s.walk[i].world_from_cam, s.camera, "x.png"), finder.Annotate(depth, "x.png"));
+    for (const PlaneMatch& m : c.matches) {
+      ious.push_back(m.iou);
+      worst_angle = std::max(worst_angle, m.normal_angle_deg);
+    }
+    comparisons.push_back(c);
+  }
+  const PlaneComparisonSummary summary = Summarise(comparisons);
+  std::sort(ious.begin(), ious.end());
+  ASSERT_GE(ious.size(), 40u);
+  EXPECT_GT(ious[ious.size() / 2], 0.9);  // median IoU of matched planes
+  EXPECT_GT(ious[ious.size() / 4], 0.8);  // three quarters of them above 0.8
+  EXPECT_LT(worst_angle, 2.0);
+  std::printf("annotate-depth on a synthetic street: %d of %d planes matched, IoU median %.3f, lower quartile %.3f, "
+              "worst normal %.4f deg\n", summary.matched, summary.reference_planes, ious[ious.size() / 2],
+              ious[ious.size() / 4], worst_angle);
+}
+
+TEST(Synth, ShippedDefaultConfigEqualsTheDefaults) {
+  EXPECT_EQ(LoadOptions<SynthOptions>(PDVO_SOURCE_DIR "/sim/config/default.yaml", "synth"), SynthOptions());
+}
+
+}  // namespace
+}  // namespace pdvo::sim
