@@ -102,9 +102,9 @@ int RunAnnotateDepth(int argc, char** argv) {
     const PlaneComparisonSummary s = Summarise(comparisons);
     char buf[256];
     std::snprintf(buf, sizeof(buf),
-                  "compared %d frames: %d of %d reference planes matched; median IoU %.3f; normal angle median "
-                  "%.2f, mean %.2f, 90%% %.2f deg",
-                  s.frames, s.matched, s.reference_planes, s.median_iou, s.median_normal_angle_deg,
+                  "compared %d frames: %d of %d reference planes matched; median IoU %.3f (matched planes: %.3f); "
+                  "normal angle median %.2f, mean %.2f, 90%% %.2f deg",
+                  s.frames, s.matched, s.reference_planes, s.median_iou, s.median_matched_iou, s.median_normal_angle_deg,
                   s.mean_normal_angle_deg, s.p90_normal_angle_deg);
     PDVO_LOG(Info) << buf;
     if (!json_path.empty()) WriteFileAtomically(json_path, ToJson(comparisons).dump(1) + "\n");

@@ -47,8 +47,8 @@ int RunCompare(int argc, char** argv) {
   char buf[320];
   std::snprintf(buf, sizeof(buf),
                 "%d frames (%zu without an estimate): %d of %d reference planes matched; IoU median %.3f, mean "
-                "%.3f; normal angle median %.2f, mean %.2f, 90%% %.2f deg",
-                s.frames, missing, s.matched, s.reference_planes, s.median_iou, s.mean_iou,
+                "%.3f (matched planes: median %.3f); normal angle median %.2f, mean %.2f, 90%% %.2f deg",
+                s.frames, missing, s.matched, s.reference_planes, s.median_iou, s.mean_iou, s.median_matched_iou,
                 s.median_normal_angle_deg, s.mean_normal_angle_deg, s.p90_normal_angle_deg);
   std::printf("%s\n", buf);
   if (!json_path.empty()) WriteFileAtomically(json_path, ToJson(comparisons).dump(1) + "\n");

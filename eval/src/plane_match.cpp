@@ -97,13 +97,14 @@ PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& est
 
 PlaneComparisonSummary Summarise(const std::vector<PlaneComparison>& comparisons) {
   PlaneComparisonSummary s;
-  std::vector<double> ious, angles;
+  std::vector<double> ious, matched_ious, angles;
   for (const PlaneComparison& c : comparisons) {
     ++s.frames;
     s.reference_planes += c.reference_planes;
     s.matched += static_cast<int>(c.matches.size());
     for (const PlaneMatch& m : c.matches) {
       ious.push_back(m.iou);
+      matched_ious.push_back(m.iou);
       if (m.normal_angle_deg >= 0) angles.push_back(m.normal_angle_deg);
     }
     // Unmatched reference planes count as IoU 0.
@@ -111,6 +112,7 @@ PlaneComparisonSummary Summarise(const std::vector<PlaneComparison>& comparisons
   }
   s.median_iou = Median(ious);
   s.mean_iou = Mean(ious);
+  s.median_matched_iou = Median(matched_ious);
   s.median_normal_angle_deg = Median(angles);
   s.mean_normal_angle_deg = Mean(angles);
   s.p90_normal_angle_deg = Percentile(angles, 0.9);
@@ -125,6 +127,7 @@ nlohmann::json ToJson(const std::vector<PlaneComparison>& comparisons) {
                   {"matched", s.matched},
                   {"median_iou", s.median_iou},
                   {"mean_iou", s.mean_iou},
+                  {"median_matched_iou", s.median_matched_iou},
                   {"median_normal_angle_deg", s.median_normal_angle_deg},
                   {"mean_normal_angle_deg", s.mean_normal_angle_deg},
                   {"p90_normal_angle_deg", s.p90_normal_angle_deg}};

@@ -57,6 +57,7 @@ TEST(PlaneMatch, OneToOneAndUnmatchedCountAsZero) {
   const PlaneComparisonSummary s = Summarise({c});
   EXPECT_EQ(s.reference_planes, 2);
   EXPECT_NEAR(s.median_iou, 0.25, 1e-12);  // median of {0.5, 0}
+  EXPECT_NEAR(s.median_matched_iou, 0.5, 1e-12);
   Annotation other = est;
   other.image_width = 300;
   EXPECT_THROW(ComparePlanes(ref, other), InvalidArgument);
