@@ -37,10 +37,7 @@ int RunAnnotateDepth(int argc, char** argv) {
   PDVO_THROW_CHECK(json_path.empty() || !reference_dir.empty(), InvalidArgument, "--json needs --reference");
   if (!reference_dir.empty()) CheckExists(reference_dir, "reference folder");
 
-  DepthPlaneOptions options;
-  if (!config_path.empty()) options = LoadOptions<DepthPlaneOptions>(config_path, "annotate_depth");
-  ApplyOverrides(options, overrides);
-  CheckOptionsOrThrow(options, "annotate-depth options");
+  const auto options = LoadToolOptions<DepthPlaneOptions>(config_path, "annotate_depth", overrides);
 
   std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
   Camera camera;

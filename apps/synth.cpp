@@ -24,10 +24,7 @@ int RunSynth(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
-  sim::SynthOptions options;
-  if (!config_path.empty()) options = LoadOptions<sim::SynthOptions>(config_path, "synth");
-  ApplyOverrides(options, overrides);
-  CheckOptionsOrThrow(options, "synth options");
+  const auto options = LoadToolOptions<sim::SynthOptions>(config_path, "synth", overrides);
   Progress progress("synth", static_cast<size_t>(frames));
   sim::WriteSynthSequence(out_dir, seed, frames, options, [&] { progress.Step(); });
   progress.Finish();

@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+
+#include "pdvo/common/options.h"
 #include <string>
 #include <vector>
 
@@ -24,6 +26,18 @@ void ApplyVerbosity(const std::string& verbosity);
       return 1;                                                                                    \
     }                                                                                              \
   } while (false)
+
+// A tool's options: the defaults, then the section `section` of --config (if given), then the --set overrides;
+// checked. Throws pdvo::Error naming the file or option at fault.
+template <class Options>
+Options LoadToolOptions(const std::string& config_path, const std::string& section,
+                        const std::vector<std::string>& overrides) {
+  Options options;
+  if (!config_path.empty()) options = LoadOptions<Options>(config_path, section);
+  ApplyOverrides(options, overrides);
+  CheckOptionsOrThrow(options, section + " options");
+  return options;
+}
 
 // Subcommands: each parses its own flags, returns 0 on success and throws pdvo::Error on failure.
 int RunShow(int argc, char** argv);

@@ -181,5 +181,18 @@ TEST(Cli, AnnotateDepthWritesValidAnnotationsAndNothingOnFailure) {
   EXPECT_TRUE(fs::exists(dir / "out/2.json"));
 }
 
+TEST(Cli, SynthWritesASequenceAndRejectsUnknownOptions) {
+  test::TempDir dir;
+  const CommandResult bad = Pdvo("synth -o " + (dir / "s") + " -n 3 --set street.lopp=true", dir);
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_EQ(Lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("unknown option 'lopp'"), std::string::npos) << bad.err;
+  const CommandResult ok = Pdvo("synth -o " + (dir / "s") + " -n 3 --seed 5 --set width=160 --set height=120", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(cv::imread(dir / "s/rgb/000002.png").cols, 160);
+  EXPECT_EQ(Pdvo("validate " + (dir / "s/annotations"), dir).code, 0);
+  EXPECT_TRUE(fs::exists(dir / "s/synth.yaml"));
+}
+
 }  // namespace
 }  // namespace pdvo

@@ -46,7 +46,8 @@ struct RenderedFrame {
 
 class Renderer {
  public:
-  // Builds the textures (once). Throws InvalidArgument for a camera with distortion or bad options.
+  // Builds the textures (once). `street` is referenced, not copied: it must outlive the renderer. Throws
+  // InvalidArgument for a camera with distortion or bad options.
   Renderer(const Street& street, const Camera& camera, const RenderOptions& options, uint64_t seed);
 
   // Depth and ids only: exact and fast.
