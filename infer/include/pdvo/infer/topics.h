@@ -1,0 +1,14 @@
+// Topic weights of a new region: the non-negative projection of its visual-word histogram onto a learned topic
+// basis (from orthogonal NMF, train/onmf.h). The paper's section III, after Haines & Calway.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace pdvo {
+
+// The non-negative h minimising |histogram - basis * h|^2 (basis: words x topics, non-negative), by
+// multiplicative updates started from max(basis^T histogram, 0) + epsilon. `iterations` bounds the work.
+Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::VectorXd& histogram,
+                                  int iterations = 200);
+
+}  // namespace pdvo
