@@ -1,0 +1,146 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/vocab/features.h"
+#include "pdvo/vocab/vocabulary.h"
+
+namespace pdvo {
+namespace {
+
+// Blotchy noise with rectangles on it, like a cluttered scene.
+cv::Mat Textured(int w, int h, unsigned seed) {
+  cv::Mat image(h, w, CV_8UC3);
+  std::mt19937 rng(seed);
+  for (int i = 0; i < static_cast<int>(image.total() * 3); ++i) image.data[i] = static_cast<uchar>(rng() % 256);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  std::uniform_int_distribution<int> x(0, w - 1), y(0, h - 1), c(0, 255);
+  for (int k = 0; k < 150; ++k) {
+    cv::rectangle(image, cv::Rect(x(rng), y(rng), 6 + x(rng) % 20, 6 + y(rng) % 20), cv::Scalar(c(rng), c(rng), c(rng)),
+                  cv::FILLED);
+  }
+  return image;
+}
+
+TEST(Features, PointsHaveBothDescriptorsAndWholePatches) {
+  const cv::Mat image = Textured(320, 240, 1);
+  FeatureOptions o;
+  o.max_points = 300;
+  for (const char* detector : {"fast", "gftt", "dense"}) {
+    o.detector = detector;
+    const Features f = ExtractFeatures(image, o);
+    EXPECT_GT(f.size(), 50u) << detector << " found " << f.size();
+    EXPECT_LE(f.size(), 300u) << detector;
+    EXPECT_EQ(f.gradient.rows, static_cast<int>(f.size()));
+    EXPECT_EQ(f.gradient.cols, kGradientDims);
+    EXPECT_EQ(f.colour.cols, kColourDims);
+    for (const cv::Point2f& p : f.points) {
+      EXPECT_GE(p.x, o.patch_size / 2.0f);
+      EXPECT_LE(p.x, image.cols - 1 - o.patch_size / 2.0f);
+    }
+  }
+}
+
+TEST(Features, MaskAndFlatImages) {
+  const cv::Mat image = Textured(320, 240, 2);
+  cv::Mat mask(240, 320, CV_8U, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 160, 240)).setTo(255);
+  const Features f = ExtractFeatures(image, {}, mask);
+  ASSERT_GT(f.size(), 0u);
+  for (const cv::Point2f& p : f.points) EXPECT_LT(p.x, 160.5f);
+  const Features none = ExtractFeatures(cv::Mat(100, 100, CV_8UC3, cv::Scalar(50, 50, 50)), {});
+  EXPECT_EQ(none.size(), 0u);
+  EXPECT_EQ(none.gradient.cols, kGradientDims);
+  EXPECT_THROW(ExtractFeatures(cv::Mat(10, 10, CV_8U), {}), InvalidArgument);
+  FeatureOptions bad;
+  bad.detector = "orb";
+  EXPECT_THROW(ExtractFeatures(image, bad), InvalidArgument);
+}
+
+TEST(Features, ColourDescriptorIsTheLabMeanOfEachCell) {
+  const cv::Scalar red(30, 40, 200);
+  const cv::Mat image(64, 64, CV_8UC3, red);
+  FeatureOptions o;
+  o.detector = "dense";
+  o.grid_step = 16;
+  const Features f = ExtractFeatures(image, o);
+  ASSERT_GT(f.size(), 0u);
+  cv::Mat lab;
+  cv::cvtColor(cv::Mat(1, 1, CV_8UC3, red), lab, cv::COLOR_BGR2Lab);
+  for (int k = 0; k < kColourDims; ++k) EXPECT_NEAR(f.colour.at<float>(0, k), lab.at<cv::Vec3b>(0)[k % 3] / 255.0f, 1e-6);
+}
+
+// Well separated blobs: the vocabulary must put each blob in a word of its own.
+cv::Mat Blobs(int per_blob, int blobs, int dims, unsigned seed, std::vector<int>* truth) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g(0, 0.1f);
+  cv::Mat data(per_blob * blobs, dims, CV_32F);
+  for (int b = 0; b < blobs; ++b) {
+    for (int i = 0; i < per_blob; ++i) {
+      for (int d = 0; d < dims; ++d) data.at<float>(b * per_blob + i, d) = (d == b ? 5.0f : 0.0f) + g(rng);
+      truth->push_back(b);
+    }
+  }
+  return data;
+}
+
+TEST(Vocabulary, KMeansFindsSeparatedClustersAndIsRepeatable) {
+  std::vector<int> truth;
+  const cv::Mat data = Blobs(100, 5, 16, 3, &truth);
+  const Vocabulary v = Vocabulary::Build(data, 5, 7);
+  const std::vector<int> words = v.Quantise(data);
+  // Each blob maps to exactly one word, and different blobs to different words.
+  std::vector<int> word_of(5, -1);
+  for (size_t i = 0; i < words.size(); ++i) {
+    if (word_of[truth[i]] < 0) word_of[truth[i]] = words[i];
+    EXPECT_EQ(words[i], word_of[truth[i]]);
+  }
+  std::sort(word_of.begin(), word_of.end());
+  EXPECT_EQ(std::unique(word_of.begin(), word_of.end()) - word_of.begin(), 5);
+  const Vocabulary again = Vocabulary::Build(data, 5, 7);
+  EXPECT_EQ(cv::norm(v.centres(), again.centres(), cv::NORM_INF), 0.0);
+  EXPECT_THROW(Vocabulary::Build(data.rowRange(0, 3), 5, 7), InvalidArgument);
+}
+
+TEST(Vocabulary, FlannQuantisationMatchesBruteForce) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0, 1);
+  cv::Mat data(3000, 32, CV_32F), queries(1000, 32, CV_32F);
+  for (int i = 0; i < static_cast<int>(data.total()); ++i) data.at<float>(i) = u(rng);
+  for (int i = 0; i < static_cast<int>(queries.total()); ++i) queries.at<float>(i) = u(rng);
+  const Vocabulary v = Vocabulary::Build(data, 100, 1, 10);
+  const std::vector<int> fast = v.Quantise(queries, 512);
+  int agree = 0;
+  for (int q = 0; q < queries.rows; ++q) {
+    double best = 1e18;
+    int nearest = -1;
+    for (int c = 0; c < v.size(); ++c) {
+      const double d = cv::norm(queries.row(q), v.centres().row(c), cv::NORM_L2SQR);
+      if (d < best) best = d, nearest = c;
+    }
+    agree += nearest == fast[q];
+  }
+  EXPECT_GE(agree, 0.99 * queries.rows);
+  const cv::Mat h = v.Histogram(queries);
+  EXPECT_NEAR(cv::sum(h)[0], 1.0, 1e-5);
+  EXPECT_THROW(v.Quantise(cv::Mat(2, 31, CV_32F, cv::Scalar(0))), InvalidArgument);
+}
+
+TEST(Vocabulary, RoundTripThroughFileStorage) {
+  std::vector<int> truth;
+  const cv::Mat data = Blobs(50, 4, 8, 5, &truth);
+  const Vocabulary v = Vocabulary::Build(data, 4, 2);
+  cv::FileStorage out(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  v.Write(out, "gradient_words");
+  const std::string text = out.releaseAndGetString();
+  cv::FileStorage in(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  const Vocabulary back = Vocabulary::Read(in["gradient_words"], "model");
+  EXPECT_EQ(back.Quantise(data), v.Quantise(data));
+  EXPECT_THROW(Vocabulary::Read(in["colour_words"], "model"), FormatError);
+}
+
+}  // namespace
+}  // namespace pdvo

@@ -1,0 +1,45 @@
+// Salient points and their descriptors (the paper's section III, step 1-2): a gradient descriptor (OpenCV's SIFT
+// computed at the points, 128-D) and a colour descriptor (mean CIE Lab in the 2x2 cells of the point's patch,
+// 12-D), for every point of an image or of a region.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace pdvo {
+
+struct FeatureOptions {
+  std::string detector = "fast";  // salient points: fast, gftt (Shi-Tomasi) or dense (a grid)
+  int max_points = 1500;          // per image, strongest first
+  int patch_size = 16;            // px, the patch described around each point
+  int fast_threshold = 15;        // FAST intensity threshold
+  int grid_step = 8;              // px, dense detector spacing
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("detector", self.detector);
+    visit("max_points", self.max_points);
+    visit("patch_size", self.patch_size);
+    visit("fast_threshold", self.fast_threshold);
+    visit("grid_step", self.grid_step);
+  }
+  bool Check() const;
+  bool operator==(const FeatureOptions&) const = default;
+};
+
+inline constexpr int kGradientDims = 128;
+inline constexpr int kColourDims = 12;
+
+struct Features {
+  std::vector<cv::Point2f> points;  // pixels
+  cv::Mat gradient;                 // N x 128, CV_32F
+  cv::Mat colour;                   // N x 12, CV_32F
+  size_t size() const { return points.size(); }
+};
+
+// Points whose whole patch lies inside the image (and inside `mask` where it is non-zero, if given).
+// `image` is 8-bit BGR. Throws InvalidArgument for another type or bad options.
+Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options, const cv::Mat& mask = cv::Mat());
+
+}  // namespace pdvo
