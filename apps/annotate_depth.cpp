@@ -26,8 +26,7 @@ int RunAnnotateDepth(int argc, char** argv) {
   app.add_option("--sequence,-s", sequence_path, "RGB-D sequence folder (rgb.txt, depth.txt)")->required();
   app.add_option("--out,-o", out_dir, "Folder for the annotations (<image name>.json)")->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML (default: camera.yaml in the sequence folder)");
-  app.add_option("--config", config_path, "Options YAML (section annotate_depth:)");
-  app.add_option("--set", overrides, "Override an option, e.g. --set inlier_sigmas=2.5");
+  AddConfigFlags(app, &config_path, &overrides, "Options YAML (section annotate_depth:)", "inlier_sigmas=2.5");
   app.add_option("--every", every, "Annotate every N-th frame")->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--reference", reference_dir, "Folder of reference annotations to compare with");
   app.add_option("--json", json_path, "Write the comparison report (needs --reference) as JSON");

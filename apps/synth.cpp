@@ -18,8 +18,8 @@ int RunSynth(int argc, char** argv) {
   app.add_option("--out,-o", out_dir, "Output folder")->required();
   app.add_option("--seed", seed, "Scene and walk seed")->capture_default_str();
   app.add_option("--frames,-n", frames, "Number of frames")->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--config", config_path, "Options YAML (section synth:, see sim/config/default.yaml)");
-  app.add_option("--set", overrides, "Override an option, e.g. --set street.loop=true --set width=640");
+  AddConfigFlags(app, &config_path, &overrides, "Options YAML (section synth:, see sim/config/default.yaml)",
+                 "street.loop=true --set width=640");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);

@@ -11,6 +11,12 @@ void AddVerbosityFlag(CLI::App& app, std::string* verbosity) {
       ->capture_default_str();
 }
 
+void AddConfigFlags(CLI::App& app, std::string* config_path, std::vector<std::string>* overrides,
+                    const std::string& config_help, const std::string& set_example) {
+  app.add_option("--config", *config_path, config_help);
+  app.add_option("--set", *overrides, "Override an option, e.g. --set " + set_example);
+}
+
 void ApplyVerbosity(const std::string& verbosity) {
   const LogLevel level = ParseLogLevel(verbosity);
   SetLogLevel(level);

@@ -27,6 +27,10 @@ void ApplyVerbosity(const std::string& verbosity);
     }                                                                                              \
   } while (false)
 
+// Adds --config FILE and repeatable --set key=value.
+void AddConfigFlags(CLI::App& app, std::string* config_path, std::vector<std::string>* overrides,
+                    const std::string& config_help, const std::string& set_example);
+
 // A tool's options: the defaults, then the section `section` of --config (if given), then the --set overrides;
 // checked. Throws pdvo::Error naming the file or option at fault.
 template <class Options>

@@ -1,11 +1,15 @@
 # pdvo_add_library(NAME <name> SRCS <files> [PUBLIC_LINK <libs>] [PRIVATE_LINK <libs>])
-# Builds pdvo_<name> from <name>/src, with public headers in <name>/include.
+# Builds pdvo_<name> from <name>/src, with public headers in <name>/include, and its tests from tests/<name>/.
 function(pdvo_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_LINK;PRIVATE_LINK" ${ARGN})
   set(target pdvo_${ARG_NAME})
   add_library(${target} STATIC ${ARG_SRCS})
   target_include_directories(${target} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINK} PRIVATE ${ARG_PRIVATE_LINK})
+  # The library's tests live in tests/<name>/.
+  if(PDVO_BUILD_TESTS AND EXISTS ${CMAKE_SOURCE_DIR}/tests/${ARG_NAME}/CMakeLists.txt)
+    add_subdirectory(${CMAKE_SOURCE_DIR}/tests/${ARG_NAME} ${CMAKE_BINARY_DIR}/tests/${ARG_NAME})
+  endif()
 endfunction()
 
 # pdvo_add_test(LIB <lib> NAME <unit> [LINK <libs>] [LABELS <labels>])

@@ -5,26 +5,13 @@
 #include <random>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/test/topics.h"
 
 namespace pdvo {
 namespace {
 
-// Topics with disjoint sets of words (orthogonal unit columns) and random non-negative weights.
-struct Known {
-  Eigen::MatrixXd basis, weights, data;
-  Known(int words, int topics, int regions, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    basis = Eigen::MatrixXd::Zero(words, topics);
-    for (int w = 0; w < words; ++w) basis(w, w % topics) = 0.2 + u(rng);
-    for (int t = 0; t < topics; ++t) basis.col(t).normalize();
-    weights = Eigen::MatrixXd::NullaryExpr(topics, regions, [&]() { return u(rng) < 0.3 ? 0.0 : 5 * u(rng); });
-    data = basis * weights;
-  }
-};
-
 TEST(Topics, ProjectionRecoversKnownWeights) {
-  const Known known(60, 5, 20, 7);
+  const test::KnownTopics known(60, 5, 20, 7);
   for (int region = 0; region < 20; ++region) {
     const Eigen::VectorXd h = ProjectOntoTopics(known.basis, known.data.col(region));
     EXPECT_LT((h - known.weights.col(region)).cwiseAbs().maxCoeff(), 1e-6) << region;

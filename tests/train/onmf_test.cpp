@@ -5,26 +5,13 @@
 #include <random>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/test/topics.h"
 
 namespace pdvo {
 namespace {
 
-// A known factorisation: topics with disjoint sets of words (so exactly orthogonal), random weights.
-struct Known {
-  Eigen::MatrixXd basis, weights, data;
-  Known(int words, int topics, int regions, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    basis = Eigen::MatrixXd::Zero(words, topics);
-    for (int w = 0; w < words; ++w) basis(w, w % topics) = 0.2 + u(rng);
-    for (int t = 0; t < topics; ++t) basis.col(t).normalize();
-    weights = Eigen::MatrixXd::NullaryExpr(topics, regions, [&]() { return u(rng) < 0.3 ? 0.0 : 5 * u(rng); });
-    data = basis * weights;
-  }
-};
-
 TEST(Onmf, RecoversAKnownOrthogonalFactorisation) {
-  const Known known(60, 5, 200, 3);
+  const test::KnownTopics known(60, 5, 200, 3);
   OnmfOptions options;
   options.topics = 5;
   options.max_iterations = 3000;
@@ -45,7 +32,7 @@ TEST(Onmf, RecoversAKnownOrthogonalFactorisation) {
 }
 
 TEST(Onmf, ErrorNeverRisesMuchAndSeedsRepeat) {
-  const Known known(40, 4, 100, 5);
+  const test::KnownTopics known(40, 4, 100, 5);
   OnmfOptions options;
   options.topics = 4;
   options.max_iterations = 300;
