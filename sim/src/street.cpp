@@ -281,7 +281,18 @@ Street StreetBuilder::Build(double min_length) {
 Street GenerateStreet(const StreetOptions& options, double min_length, uint64_t seed) {
   CheckOptionsOrThrow(options, "street options");
   StreetBuilder builder(options, seed);
-  return builder.Build(min_length);
+  Street street = builder.Build(min_length);
+  for (WorldPlane& a : street.planes) {
+    a.surface = a.id;
+    for (const WorldPlane& b : street.planes) {
+      if (b.id >= a.id) break;
+      if (a.normal.dot(b.normal) > 1 - 1e-9 && std::abs(a.distance - b.distance) < 1e-6) {
+        a.surface = b.surface;
+        break;
+      }
+    }
+  }
+  return street;
 }
 
 namespace {

@@ -38,27 +38,16 @@ Annotation AnnotateFrame(const Street& street, const RenderedFrame& frame, const
   a.image_width = camera.width;
   a.image_height = camera.height;
   a.camera = AnnotationCamera{camera.fx, camera.fy, camera.cx, camera.cy};
-  // Polygons of one geometric plane (the ground of every segment, neighbouring facades on one line) are one
-  // plane: group them by their plane equation.
-  std::vector<int> group(street.planes.size());
-  for (size_t i = 0; i < street.planes.size(); ++i) {
-    group[i] = static_cast<int>(i);
-    for (size_t j = 0; j < i; ++j) {
-      const WorldPlane &a = street.planes[i], &b = street.planes[j];
-      if (a.normal.dot(b.normal) > 1 - 1e-9 && std::abs(a.distance - b.distance) < 1e-6) {
-        group[i] = group[j];
-        break;
-      }
-    }
-  }
   // Visible planes, by pixel count, largest first.
   std::vector<int> count(street.planes.size(), 0);
   cv::Mat grouped(frame.id.size(), CV_32S, cv::Scalar(-1));
   for (int i = 0; i < static_cast<int>(frame.id.total()); ++i) {
     const int id = frame.id.at<int>(i);
     if (id < 0) continue;
-    grouped.at<int>(i) = group[id];
-    ++count[group[id]];
+    // Coplanar polygons (the road and pavements, say) are one plane.
+    const int surface = street.planes[id].surface;
+    grouped.at<int>(i) = surface;
+    ++count[surface];
   }
   std::vector<int> visible;
   for (size_t id = 0; id < count.size(); ++id) {
@@ -97,6 +86,7 @@ nlohmann::json PlanesJson(const Street& street) {
                       {"material", MaterialName(p.material)},
                       {"normal", {p.normal.x(), p.normal.y(), p.normal.z()}},
                       {"distance", p.distance},
+                      {"surface", p.surface},
                       {"polygon", polygon}});
   }
   return {{"frame", "world: y down, ground y = 0; plane: normal . x + distance = 0, normal facing the street"},

@@ -70,6 +70,8 @@ struct WorldPlane {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero(), axis_u = Eigen::Vector3d::Zero(), axis_v = Eigen::Vector3d::Zero();
   double width = 0, height = 0;  // extent of the polygon in texture coordinates, metres
   uint32_t texture_seed = 0;     // the facade's own windows, doors and signs
+  int surface = 0;               // id of the first plane with the same equation (the ground of every segment,
+                                 // neighbouring facades on one line): one geometric plane
 };
 
 // A non-planar object: an ellipsoid (centre, semi-axes along the world axes rotated by yaw about y) or a
