@@ -10,8 +10,6 @@
 namespace pdvo::apps {
 namespace fs = std::filesystem;
 
-std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inputs);
-
 int RunCompare(int argc, char** argv) {
   CLI::App app("Matches the planes of estimated annotations (detections, or annotate-depth output) with those of "
                "reference annotations of the same name, one to one by IoU, and reports IoU and normal angle per "

@@ -43,6 +43,10 @@ Options LoadToolOptions(const std::string& config_path, const std::string& secti
   return options;
 }
 
+// Every .json file among the given files and folders (folders not recursed), sorted; throws IoError for a
+// missing path and FormatError for a folder without annotations.
+std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inputs);
+
 // Subcommands: each parses its own flags, returns 0 on success and throws pdvo::Error on failure.
 int RunShow(int argc, char** argv);
 int RunValidate(int argc, char** argv);

@@ -10,7 +10,6 @@
 
 namespace pdvo::apps {
 
-// Every .json file under the given files and folders (folders not recursed), sorted.
 std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inputs) {
   std::vector<std::string> files;
   for (const std::string& input : inputs) {

@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <opencv2/imgproc.hpp>
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"

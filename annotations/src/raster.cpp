@@ -84,17 +84,30 @@ std::vector<std::pair<int, int>> FindLabelConflicts(const Annotation& a) {
   std::vector<std::pair<int, int>> conflicts;
   const cv::Rect image(0, 0, a.image_width, a.image_height);
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  // Each shape's interior, once: its mask inside its bounding box, eroded so that a shared edge does not count.
+  struct Interior {
+    cv::Rect box;
+    cv::Mat mask;
+  };
+  std::vector<Interior> interiors(a.shapes.size());
+  auto interior = [&](size_t i) -> const Interior& {
+    Interior& in = interiors[i];
+    if (in.mask.empty()) {
+      in.box = BoundingBox(a.shapes[i]) & image;
+      if (in.box.area() > 0) cv::erode(RasteriseShape(a.shapes[i], a)(in.box), in.mask, kernel);
+    }
+    return in;
+  };
   for (size_t i = 0; i < a.shapes.size(); ++i) {
     if (!a.shapes[i].IsPlane() || a.shapes[i].points.size() < 3) continue;
     for (size_t j = 0; j < a.shapes.size(); ++j) {
       if (!a.shapes[j].IsNonPlane() || a.shapes[j].points.size() < 3) continue;
       const cv::Rect common = BoundingBox(a.shapes[i]) & BoundingBox(a.shapes[j]) & image;
       if (common.area() == 0) continue;
-      // Interiors only: erode both so that a shared edge does not count.
-      cv::Mat mi, mj;
-      cv::erode(RasteriseShape(a.shapes[i], a)(common), mi, kernel);
-      cv::erode(RasteriseShape(a.shapes[j], a)(common), mj, kernel);
-      if (cv::countNonZero(mi & mj) > 0) conflicts.emplace_back(static_cast<int>(i), static_cast<int>(j));
+      const Interior& pi = interior(i);
+      const Interior& pj = interior(j);
+      const cv::Mat overlap = pi.mask(common - pi.box.tl()) & pj.mask(common - pj.box.tl());
+      if (cv::countNonZero(overlap) > 0) conflicts.emplace_back(static_cast<int>(i), static_cast<int>(j));
     }
   }
   return conflicts;

@@ -4,7 +4,6 @@
 #include <random>
 
 #include "pdvo/common/errors.h"
-#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 
 namespace pdvo::sim {
@@ -202,7 +201,7 @@ void StreetBuilder::AddClutter(size_t i, int side) {
               crown + Eigen::Vector3d(Uniform(-0.9, 0.9), Uniform(-0.7, 0.6), Uniform(-0.9, 0.9)), {s, s * 0.85, s}, 0,
               green);
     }
-    if (Chance(0.4)) {
+    if (Chance(0.4) && t + o_.tree_spacing / 2 < length - 3) {  // bushes stay on their own segment
       const Eigen::Vector3d bush = along(t + o_.tree_spacing / 2, half + o_.pavement_width - 0.5, 0.35);
       for (int k = 0; k < 3; ++k) {
         AddBlob(WorldBlob::Kind::kEllipsoid, Material::kLeaves, bush + Eigen::Vector3d(Uniform(-0.5, 0.5), 0, Uniform(-0.5, 0.5)),

@@ -68,18 +68,21 @@ TEST(Ate, NoiseOfKnownSizeGivesItsRmse) {
 }
 
 TEST(Ate, AssociationRespectsMaxDtAndUsesEachPoseOnce) {
-  Trajectory gt = Curve(10), est = Curve(10);
-  for (StampedPose& p : est) p.timestamp += 0.004;
-  est[5].timestamp += 0.1;  // far from any ground-truth pose... but still after est[4]
-  est[6].timestamp += 0.1;
-  std::vector<double> times;
+  const Trajectory gt = Curve(10);  // 30 Hz
+  Trajectory est;
+  auto at = [&](double t) { est.push_back({t, gt[0].world_from_cam}); };
+  at(gt[0].timestamp + 0.003);  // -> gt 0
+  at(gt[2].timestamp + 0.003);  // -> gt 2, the closer of two estimates that want it
+  at(gt[2].timestamp + 0.008);  // gt 2 is taken; gt 3 is 25 ms away, beyond max_dt: no pair
+  at(gt[9].timestamp + 0.5);    // after the ground truth ends: no pair
   const auto pairs = AssociateByTime(gt, est, 0.01);
-  // est 5 and 6 now sit near gt 8 and 9 (0.1 s later); est 8 and 9 compete for them and lose.
-  for (const auto& [g, e] : pairs) EXPECT_LE(std::abs(gt[g].timestamp - est[e].timestamp), 0.01);
-  std::vector<int> used(10, 0);
-  for (const auto& [g, e] : pairs) ++used[g];
-  for (int u : used) EXPECT_LE(u, 1);
-  EXPECT_EQ(pairs.size(), 8u);
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0], (std::pair<size_t, size_t>{0, 0}));
+  EXPECT_EQ(pairs[1], (std::pair<size_t, size_t>{2, 1}));
+  // With a wider window the third estimate takes gt 3.
+  const auto wide = AssociateByTime(gt, est, 0.03);
+  ASSERT_EQ(wide.size(), 3u);
+  EXPECT_EQ(wide[2], (std::pair<size_t, size_t>{3, 2}));
 }
 
 TEST(Ate, ErrorsForTooFewPosesEmptyInputAndStillEstimates) {
