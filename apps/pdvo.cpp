@@ -22,6 +22,8 @@ constexpr Command kCommands[] = {
     {"annotate-depth", pdvo::apps::RunAnnotateDepth, "find planes in RGB-D depth maps and write annotations"},
     {"compare", pdvo::apps::RunCompare, "match estimated planes to reference annotations: IoU, normal angle"},
     {"synth", pdvo::apps::RunSynth, "render a synthetic urban street sequence with exact ground truth"},
+    {"train", pdvo::apps::RunTrain, "train the plane recogniser on annotations into one model file"},
+    {"evaluate", pdvo::apps::RunEvaluate, "region recognition accuracy and normal error of a model"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
 };
 

@@ -54,5 +54,7 @@ int RunAnnotateDepth(int argc, char** argv);
 int RunCompare(int argc, char** argv);
 int RunAte(int argc, char** argv);
 int RunSynth(int argc, char** argv);
+int RunTrain(int argc, char** argv);
+int RunEvaluate(int argc, char** argv);
 
 }  // namespace pdvo::apps

@@ -73,6 +73,60 @@ TEST(Features, ColourDescriptorIsTheLabMeanOfEachCell) {
   for (int k = 0; k < kColourDims; ++k) EXPECT_NEAR(f.colour.at<float>(0, k), lab.at<cv::Vec3b>(0)[k % 3] / 255.0f, 1e-6);
 }
 
+// The gradient descriptor turns with the image: rotating the image by 90 degrees (clockwise on screen, +90 in
+// image coordinates with y down) rotates the 4x4 cells and shifts every orientation by 2 of the 8 bins.
+TEST(Features, GradientDescriptorRotatesWithTheImage) {
+  const cv::Mat image = Textured(97, 97, 4);
+  FeatureOptions o;
+  o.detector = "dense";
+  cv::Mat mask(97, 97, CV_8U, cv::Scalar(0));
+  mask.at<uchar>(48, 48) = 255;
+  o.grid_step = 1;
+  const Features a = ExtractFeatures(image, o, mask);
+  cv::Mat rotated;
+  cv::rotate(image, rotated, cv::ROTATE_90_CLOCKWISE);
+  const Features b = ExtractFeatures(rotated, o, mask);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  // Pixel (x, y) goes to (96 - y, x): cell (cx, cy) goes to (3 - cy, cx).
+  double worst = 0, total = 0;
+  for (int cy = 0; cy < 4; ++cy) {
+    for (int cx = 0; cx < 4; ++cx) {
+      for (int bin = 0; bin < 8; ++bin) {
+        const float va = a.gradient.at<float>(0, (cy * 4 + cx) * 8 + bin);
+        const float vb = b.gradient.at<float>(0, (cx * 4 + (3 - cy)) * 8 + (bin + 2) % 8);
+        worst = std::max(worst, static_cast<double>(std::abs(va - vb)));
+        total += va;
+      }
+    }
+  }
+  EXPECT_GT(total, 100);  // a textured patch, not an empty descriptor
+  EXPECT_LT(worst, 0.05);  // float rounding of the angles at bin borders only
+}
+
+TEST(Features, GradientDescriptorOfAStepIsOneOrientation) {
+  // A vertical step, dark to bright along +x: every gradient points along +x (bin 0, or 7/0 at the border).
+  cv::Mat image(40, 40, CV_8UC3, cv::Scalar(20, 20, 20));
+  image(cv::Rect(20, 0, 20, 40)).setTo(cv::Scalar(220, 220, 220));
+  FeatureOptions o;
+  o.detector = "dense";
+  o.grid_step = 1;
+  cv::Mat mask(40, 40, CV_8U, cv::Scalar(0));
+  mask.at<uchar>(20, 20) = 255;
+  const Features f = ExtractFeatures(image, o, mask);
+  ASSERT_EQ(f.size(), 1u);
+  double along_x = 0, total = 0;
+  for (int k = 0; k < kGradientDims; ++k) {
+    total += f.gradient.at<float>(0, k);
+    if (k % 8 == 0) along_x += f.gradient.at<float>(0, k);
+  }
+  EXPECT_GT(total, 0);
+  EXPECT_NEAR(along_x / total, 1.0, 1e-4);
+  // Left and right columns of cells see no edge; the middle two do.
+  EXPECT_NEAR(f.gradient.at<float>(0, 0), 0, 1e-6);
+  EXPECT_GT(f.gradient.at<float>(0, 8), 0);
+}
+
 // Well separated blobs: the vocabulary must put each blob in a word of its own.
 cv::Mat Blobs(int per_blob, int blobs, int dims, unsigned seed, std::vector<int>* truth) {
   std::mt19937 rng(seed);

@@ -8,6 +8,69 @@
 #include "pdvo/common/options.h"
 
 namespace pdvo {
+namespace {
+
+// SIFT's layout (4x4 cells x 8 orientations), upright and at one scale: the (patch+1)^2 pixels centred on the
+// point vote with their Gaussian-weighted gradient magnitude into the two nearest orientation bins and the
+// (bilinearly) nearest cells; the histogram is normalised, clipped at 0.2, renormalised and scaled by 512.
+void DescribeGradient(const cv::Mat& magnitude, const cv::Mat& angle, cv::Point c, int patch, float* out) {
+  std::fill(out, out + kGradientDims, 0.0f);
+  const int h = patch / 2;
+  const float cell = patch / 4.0f, sigma = static_cast<float>(h);
+  for (int dy = -h; dy <= h; ++dy) {
+    const float* m = magnitude.ptr<float>(c.y + dy);
+    const float* a = angle.ptr<float>(c.y + dy);
+    const float fy = (dy + h) / cell - 0.5f;  // cell coordinate, cell centres at 0..3
+    const int y0 = static_cast<int>(std::floor(fy));
+    const float wy = fy - y0;
+    for (int dx = -h; dx <= h; ++dx) {
+      const float w = m[c.x + dx] * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma));
+      if (w == 0) continue;
+      const float fo = a[c.x + dx] * (8.0f / static_cast<float>(2 * CV_PI));
+      const int o0 = static_cast<int>(std::floor(fo));
+      const float wo = fo - o0;
+      const float fx = (dx + h) / cell - 0.5f;
+      const int x0 = static_cast<int>(std::floor(fx));
+      const float wx = fx - x0;
+      for (int iy = 0; iy < 2; ++iy) {
+        const int cy = y0 + iy;
+        if (cy < 0 || cy > 3) continue;
+        const float vy = iy ? wy : 1 - wy;
+        for (int ix = 0; ix < 2; ++ix) {
+          const int cx = x0 + ix;
+          if (cx < 0 || cx > 3) continue;
+          const float v = w * vy * (ix ? wx : 1 - wx);
+          float* bins = out + (cy * 4 + cx) * 8;
+          bins[o0 & 7] += v * (1 - wo);
+          bins[(o0 + 1) & 7] += v * wo;
+        }
+      }
+    }
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    float norm = 0;
+    for (int k = 0; k < kGradientDims; ++k) norm += out[k] * out[k];
+    norm = std::sqrt(norm);
+    if (norm <= 0) return;
+    for (int k = 0; k < kGradientDims; ++k) out[k] = pass == 0 ? std::min(out[k] / norm, 0.2f) : 512.0f * out[k] / norm;
+  }
+}
+
+// Mean CIE Lab (each channel / 255) of the 2x2 cells of the patch, from the image's integral.
+void DescribeColour(const cv::Mat& lab_sum, cv::Point c, int patch, float* out) {
+  const int h = patch / 2;
+  int k = 0;
+  for (int cy = 0; cy < 2; ++cy) {
+    for (int cx = 0; cx < 2; ++cx) {
+      const int x0 = c.x - h + cx * h, y0 = c.y - h + cy * h;  // cell [x0, x0+h) x [y0, y0+h)
+      const cv::Vec3d sum = lab_sum.at<cv::Vec3d>(y0 + h, x0 + h) - lab_sum.at<cv::Vec3d>(y0, x0 + h) -
+                            lab_sum.at<cv::Vec3d>(y0 + h, x0) + lab_sum.at<cv::Vec3d>(y0, x0);
+      for (int ch = 0; ch < 3; ++ch) out[k++] = static_cast<float>(sum[ch] / (h * h) / 255.0);
+    }
+  }
+}
+
+}  // namespace
 
 bool FeatureOptions::Check() const {
   PDVO_CHECK_OPTION(detector == "fast" || detector == "gftt" || detector == "dense");
@@ -39,10 +102,12 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
     }
   }
   // Keep points whose patch is inside the image (and the mask), strongest first, ties by position.
-  const float half = o.patch_size / 2.0f;
+  // Integer centres whose (patch+1)^2 window lies inside the image.
+  const int half = o.patch_size / 2;
   std::vector<cv::KeyPoint> kept;
   for (cv::KeyPoint k : candidates) {
-    if (k.pt.x < half || k.pt.y < half || k.pt.x > grey.cols - 1 - half || k.pt.y > grey.rows - 1 - half) continue;
+    const int x = cvRound(k.pt.x), y = cvRound(k.pt.y);
+    if (x < half || y < half || x > grey.cols - 1 - half || y > grey.rows - 1 - half) continue;
     if (!mask.empty() && !mask.at<uchar>(cvRound(k.pt.y), cvRound(k.pt.x))) continue;
     k.size = static_cast<float>(o.patch_size);
     k.angle = 0;  // upright: orientation is what the recogniser learns from
@@ -55,30 +120,35 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
   if (static_cast<int>(kept.size()) > o.max_points) kept.resize(o.max_points);
 
   Features f;
-  if (kept.empty()) {
-    f.gradient.create(0, kGradientDims, CV_32F);
-    f.colour.create(0, kColourDims, CV_32F);
-    return f;
-  }
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
-  std::vector<cv::KeyPoint> described = kept;
-  sift->compute(grey, described, f.gradient);
-  PDVO_THROW_CHECK(described.size() == kept.size(), Error, "features: SIFT dropped points");
-  cv::Mat lab;
-  cv::cvtColor(image, lab, cv::COLOR_BGR2Lab);
+  f.gradient.create(static_cast<int>(kept.size()), kGradientDims, CV_32F);
   f.colour.create(static_cast<int>(kept.size()), kColourDims, CV_32F);
-  const int h = o.patch_size / 2;
+  if (kept.empty()) return f;
+  cv::Mat gx, gy, magnitude, angle;
+  cv::Sobel(grey, gx, CV_32F, 1, 0, 1);
+  cv::Sobel(grey, gy, CV_32F, 0, 1, 1);
+  cv::cartToPolar(gx, gy, magnitude, angle);
+  // Structure tensor sums over each point's window, from integral images of gx^2, gy^2 and gx gy.
+  cv::Mat tensor_sum;
+  {
+    std::vector<cv::Mat> products = {gx.mul(gx), gy.mul(gy), gx.mul(gy)};
+    cv::Mat stacked;
+    cv::merge(products, stacked);
+    cv::integral(stacked, tensor_sum, CV_64F);
+  }
+  cv::Mat lab, lab_sum;
+  cv::cvtColor(image, lab, cv::COLOR_BGR2Lab);
+  cv::integral(lab, lab_sum, CV_64F);
   for (size_t i = 0; i < kept.size(); ++i) {
     const cv::Point c(cvRound(kept[i].pt.x), cvRound(kept[i].pt.y));
-    f.points.push_back(kept[i].pt);
-    int k = 0;
-    for (int cy = 0; cy < 2; ++cy) {
-      for (int cx = 0; cx < 2; ++cx) {
-        const cv::Rect cell(c.x - h + cx * h, c.y - h + cy * h, h, h);
-        const cv::Scalar mean = cv::mean(lab(cell & cv::Rect(0, 0, lab.cols, lab.rows)));
-        for (int ch = 0; ch < 3; ++ch) f.colour.at<float>(static_cast<int>(i), k++) = static_cast<float>(mean[ch] / 255.0);
-      }
-    }
+    f.points.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y));
+    DescribeGradient(magnitude, angle, c, o.patch_size, f.gradient.ptr<float>(static_cast<int>(i)));
+    DescribeColour(lab_sum, c, o.patch_size, f.colour.ptr<float>(static_cast<int>(i)));
+    const int h = o.patch_size / 2;
+    const cv::Vec3d t = tensor_sum.at<cv::Vec3d>(c.y + h + 1, c.x + h + 1) - tensor_sum.at<cv::Vec3d>(c.y - h, c.x + h + 1) -
+                        tensor_sum.at<cv::Vec3d>(c.y + h + 1, c.x - h) + tensor_sum.at<cv::Vec3d>(c.y - h, c.x - h);
+    double theta = 0.5 * std::atan2(2 * t[2], t[0] - t[1]);  // (-pi/2, pi/2]
+    if (theta < 0) theta += CV_PI;
+    f.orientation.push_back(static_cast<float>(std::min(theta, CV_PI - 1e-9)));
   }
   return f;
 }

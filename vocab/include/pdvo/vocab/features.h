@@ -1,6 +1,7 @@
-// Salient points and their descriptors (the paper's section III, step 1-2): a gradient descriptor (OpenCV's SIFT
-// computed at the points, 128-D) and a colour descriptor (mean CIE Lab in the 2x2 cells of the point's patch,
-// 12-D), for every point of an image or of a region.
+// Salient points and their descriptors (the paper's section III, steps 1-2): a gradient descriptor (SIFT's
+// 4x4 cells x 8 orientations, 128-D, upright and at one scale: OpenCV's SIFT builds a scale pyramid per image
+// and takes about 5x longer, see bench/recogniser_bench) and a colour descriptor (mean CIE Lab in the 2x2
+// cells of the point's patch, 12-D), for every point of an image or of a region. Points are integer pixels.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -35,10 +36,11 @@ struct Features {
   std::vector<cv::Point2f> points;  // pixels
   cv::Mat gradient;                 // N x 128, CV_32F
   cv::Mat colour;                   // N x 12, CV_32F
+  std::vector<float> orientation;   // radians in [0, pi): the patch's dominant gradient direction (structure tensor)
   size_t size() const { return points.size(); }
 };
 
-// Points whose whole patch lies inside the image (and inside `mask` where it is non-zero, if given).
+// Points whose whole (patch+1)^2 window lies inside the image (and inside `mask` where it is non-zero, if given).
 // `image` is 8-bit BGR. Throws InvalidArgument for another type or bad options.
 Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& options, const cv::Mat& mask = cv::Mat());
 

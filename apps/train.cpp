@@ -1,0 +1,48 @@
+// pdvo train --annotations DIR... --out MODEL: trains the plane recogniser into one versioned model file.
+#include <sstream>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
+#include "pdvo/train/trainer.h"
+#include "tool.h"
+
+namespace pdvo::apps {
+
+int RunTrain(int argc, char** argv) {
+  CLI::App app("Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
+               "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
+               "visual vocabularies, topics, spatiograms, an RVM classifier and RVM normal regressors. Writes one "
+               "model file (YAML) holding everything inference needs and a training card.",
+               "pdvo train");
+  std::vector<std::string> inputs, overrides;
+  std::string out_path, config_path, verbosity = "info";
+  uint64_t seed = 1;
+  int folds = 3;
+  app.add_option("--annotations,-a", inputs, "Folders (or files) of annotations; give several")->required();
+  app.add_option("--out,-o", out_path, "Model file to write (YAML)")->required();
+  AddConfigFlags(app, &config_path, &overrides, "Training options (YAML, section 'train'; see models/README.md)",
+                 "rvm.gammas=0.1,0.5");
+  app.add_option("--seed", seed, "Seed for sampling, k-means, topics and folds")->capture_default_str();
+  app.add_option("--cv", folds, "Cross-validation folds (grouped by image) to choose kernel widths; 1: none")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
+  AddVerbosityFlag(app, &verbosity);
+  PDVO_PARSE_FLAGS(app, argc, argv);
+  ApplyVerbosity(verbosity);
+
+  const TrainOptions options = LoadToolOptions<TrainOptions>(config_path, "train", overrides);
+  const std::vector<std::string> files = ListAnnotationFiles(inputs);
+  std::ostringstream data;
+  for (size_t i = 0; i < inputs.size(); ++i) data << (i ? " " : "") << inputs[i];
+  PDVO_LOG(Info) << "training on " << files.size() << " annotation files";
+  const PlaneModel model = TrainModel(files, options, seed, folds, data.str());
+  model.Write(out_path);
+  std::printf("wrote %s: %d images, %d+%d regions, cv accuracy %.3f, cv normal error %.1f deg, relevance vectors "
+              "%d (classifier) %d/%d/%d (normal)\n",
+              out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
+              model.card.cv_accuracy, model.card.cv_normal_error, model.classifier.size(), model.normal[0].size(),
+              model.normal[1].size(), model.normal[2].size());
+  return 0;
+}
+
+}  // namespace pdvo::apps

@@ -1,0 +1,78 @@
+// The plane recogniser's model: everything inference needs, in ONE versioned file (cv::FileStorage YAML):
+// the recogniser options, the two vocabularies, the topic basis, the feature standardisation, the RVM
+// classifier (plane probability) and three RVM regressors (normal components), and a training card.
+// Writing is atomic; re-writing a read model gives the same bytes.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+
+#include "pdvo/vocab/features.h"
+#include "pdvo/vocab/vocabulary.h"
+
+namespace pdvo {
+
+inline constexpr const char* kModelFormat = "pdvo-plane-model";
+inline constexpr int kModelVersion = 1;
+
+// A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
+struct RvmFunction {
+  double gamma = 1;
+  double bias = 0;
+  Eigen::VectorXd weights;  // one per relevance vector
+  Eigen::MatrixXd vectors;  // relevance vectors, one per row
+
+  double operator()(const Eigen::VectorXd& x) const;
+  int size() const { return static_cast<int>(weights.size()); }
+};
+
+struct RecogniserOptions {
+  int working_width = 320;    // images are resized to this width before description (0: as given)
+  FeatureOptions features;
+  int min_points = 8;         // regions with fewer salient points are not recognised
+  int topic_iterations = 100; // non-negative projection onto the topics
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("working_width", self.working_width);
+    visit("features", self.features);
+    visit("min_points", self.min_points);
+    visit("topic_iterations", self.topic_iterations);
+  }
+  bool Check() const;
+  bool operator==(const RecogniserOptions&) const = default;
+};
+
+// What the model was trained on and how well it did in cross-validation (filled by training).
+struct ModelCard {
+  std::string data;            // the annotation folders, as given
+  int images = 0;
+  int plane_regions = 0;       // used for the classifier (after balancing)
+  int non_plane_regions = 0;
+  int normal_regions = 0;      // used for the normal regressors
+  int folds = 0;               // cross-validation folds (grouped by image)
+  double cv_accuracy = 0;      // classifier, at the chosen kernel width
+  double cv_normal_error = 0;  // mean angle, degrees
+  int seed = 0;
+};
+
+struct PlaneModel {
+  RecogniserOptions options;
+  Vocabulary gradient_words;
+  Vocabulary colour_words;
+  Eigen::MatrixXd topics;         // (gradient words + colour words) x topics, non-negative
+  Eigen::VectorXd feature_mean;   // standardisation of the region features
+  Eigen::VectorXd feature_scale;
+  RvmFunction classifier;         // logit of the plane probability
+  std::array<RvmFunction, 3> normal;  // x, y, z of the normal before normalisation
+  ModelCard card;
+
+  std::string ToYaml() const;
+  // Throws FormatError naming `where` for another format, another version, a truncated or malformed file.
+  static PlaneModel FromYaml(const std::string& text, const std::string& where);
+  void Write(const std::string& path) const;  // atomically
+  static PlaneModel Read(const std::string& path);
+};
+
+}  // namespace pdvo

@@ -1,0 +1,82 @@
+// Recognising a region (the paper's section III): its salient points' visual words -> a topic histogram ->
+// a spatiogram -> RVMs -> plane probability and normal. An image is described once (points and words) and any
+// number of regions of it are then recognised from that description.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "pdvo/annotations/regions.h"
+#include "pdvo/infer/model.h"
+
+namespace pdvo {
+
+// Line orientations are quantised into this many bins over [0, pi).
+inline constexpr int kOrientationBins = 8;
+
+// An image's salient points and each point's gradient word, colour word and orientation bin.
+struct ImageWords {
+  std::vector<cv::Point2f> points;
+  std::vector<int> gradient;
+  std::vector<int> colour;
+  std::vector<int> orientation;
+  size_t size() const { return points.size(); }
+};
+
+ImageWords QuantiseFeatures(const Features& features, const Vocabulary& gradient_words,
+                            const Vocabulary& colour_words);
+
+// `image` resized to `working_width` (unchanged if 0 or already that wide); `scale` gets new / old width.
+cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale = nullptr);
+
+// The words of a region's points: each point contributes its gradient word and its colour word (offset past the
+// gradient words), and the normalised histogram of those words.
+struct RegionWords {
+  int points = 0;
+  std::vector<int> ids;                // 2 per point
+  std::vector<cv::Point2f> positions;  // 2 per point
+  std::vector<int> orientations;       // 1 per point (the positions of the gradient words)
+  cv::Rect2d box;                      // the region's extent in pixel-edge coordinates
+  Eigen::VectorXd histogram;           // gradient words + colour words, sums to 1 (zero if no points)
+};
+RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words, int colour_words);
+
+// The feature vector of a region (not standardised): the spatiogram of its topics (6 values per topic), then
+// the spatiogram of its points' dominant gradient orientations (6 values per orientation bin): where in the
+// region each edge direction lies, the perspective cue to the orientation of a textured plane.
+// `topics` has the gradient words' rows first, then the colour words'.
+Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& topics, int topic_iterations);
+
+// An annotation and its image at a working width (the annotation itself stays at full resolution).
+struct AnnotatedImage {
+  std::string annotation_path;
+  Annotation annotation;
+  cv::Mat image;  // 8-bit BGR, working size
+};
+// Reads, validates and resizes; throws pdvo::Error naming the file at fault (JSON or image).
+AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int working_width);
+
+struct RegionPrediction {
+  bool valid = false;        // false: too few salient points to say
+  int points = 0;
+  double plane_probability = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d(0, 0, -1);  // unit, camera frame, towards the camera
+};
+
+class Recogniser {
+ public:
+  explicit Recogniser(PlaneModel model);
+  const PlaneModel& model() const { return model_; }
+
+  // Points and words of an image already at the working size (see ToWorkingSize).
+  ImageWords Describe(const cv::Mat& image) const;
+  RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
+  // The same from a region's (not standardised) feature vector.
+  RegionPrediction Predict(const Eigen::VectorXd& feature) const;
+
+ private:
+  PlaneModel model_;
+};
+
+}  // namespace pdvo

@@ -1,0 +1,124 @@
+#include "pdvo/infer/recogniser.h"
+
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/infer/spatiogram.h"
+#include "pdvo/infer/topics.h"
+
+namespace pdvo {
+
+ImageWords QuantiseFeatures(const Features& f, const Vocabulary& gradient_words, const Vocabulary& colour_words) {
+  ImageWords w;
+  w.points = f.points;
+  w.gradient = gradient_words.Quantise(f.gradient);
+  w.colour = colour_words.Quantise(f.colour);
+  for (float theta : f.orientation) {
+    w.orientation.push_back(std::min(kOrientationBins - 1, static_cast<int>(theta / CV_PI * kOrientationBins)));
+  }
+  return w;
+}
+
+cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale) {
+  PDVO_THROW_CHECK(!image.empty(), InvalidArgument, "empty image");
+  if (working_width <= 0 || image.cols == working_width) {
+    if (scale) *scale = 1;
+    return image;
+  }
+  const double s = static_cast<double>(working_width) / image.cols;
+  cv::Mat out;
+  cv::resize(image, out, cv::Size(working_width, std::max(1, static_cast<int>(std::lround(image.rows * s)))), 0, 0,
+             s < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  if (scale) *scale = s;
+  return out;
+}
+
+RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words,
+                               int colour_words) {
+  RegionWords r;
+  r.box = cv::Rect2d(region.box.x - 0.5, region.box.y - 0.5, region.box.width, region.box.height);
+  r.histogram = Eigen::VectorXd::Zero(gradient_words + colour_words);
+  for (size_t i = 0; i < words.size(); ++i) {
+    if (!region.Contains(words.points[i])) continue;
+    const int g = words.gradient[i], c = words.colour[i];
+    PDVO_THROW_CHECK(g >= 0 && g < gradient_words && c >= 0 && c < colour_words, InvalidArgument,
+                     "region words: a word out of the vocabulary's range");
+    ++r.points;
+    r.ids.push_back(g);
+    r.ids.push_back(gradient_words + c);
+    r.positions.push_back(words.points[i]);
+    r.positions.push_back(words.points[i]);
+    r.orientations.push_back(words.orientation[i]);
+    r.histogram[g] += 1;
+    r.histogram[gradient_words + c] += 1;
+  }
+  if (r.points > 0) r.histogram /= 2.0 * r.points;
+  return r;
+}
+
+Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& topics, int topic_iterations) {
+  const Eigen::VectorXd weights = ProjectOntoTopics(topics, region.histogram, topic_iterations);
+  const Eigen::VectorXd by_topic = ComputeSpatiogram(topics, region.ids, region.positions, region.box, weights).ToVector();
+  // Orientation bins as words of an identity basis; their weights are the bins' shares of the points.
+  std::vector<cv::Point2f> points;
+  for (size_t i = 0; i < region.positions.size(); i += 2) points.push_back(region.positions[i]);
+  Eigen::VectorXd shares = Eigen::VectorXd::Zero(kOrientationBins);
+  for (int b : region.orientations) shares[b] += 1.0 / region.orientations.size();
+  const Eigen::VectorXd by_orientation =
+      ComputeSpatiogram(Eigen::MatrixXd::Identity(kOrientationBins, kOrientationBins), region.orientations, points,
+                        region.box, shares)
+          .ToVector();
+  Eigen::VectorXd feature(by_topic.size() + by_orientation.size());
+  feature << by_topic, by_orientation;
+  return feature;
+}
+
+AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int working_width) {
+  AnnotatedImage a;
+  a.annotation_path = annotation_path;
+  a.annotation = ReadAnnotation(annotation_path);
+  ValidateOrThrow(a.annotation, annotation_path);
+  const std::string image_path = ResolveImagePath(a.annotation, annotation_path);
+  const cv::Mat image = ReadImage(image_path, cv::IMREAD_COLOR);
+  PDVO_THROW_CHECK(image.cols == a.annotation.image_width && image.rows == a.annotation.image_height, FormatError,
+                   image_path << ": image is " << image.cols << "x" << image.rows << ", its annotation says "
+                              << a.annotation.image_width << "x" << a.annotation.image_height);
+  a.image = ToWorkingSize(image, working_width);
+  return a;
+}
+
+Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
+  PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(),
+                   InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
+}
+
+ImageWords Recogniser::Describe(const cv::Mat& image) const {
+  return QuantiseFeatures(ExtractFeatures(image, model_.options.features), model_.gradient_words,
+                          model_.colour_words);
+}
+
+RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
+  PDVO_THROW_CHECK(feature.size() == model_.feature_mean.size(), InvalidArgument,
+                   "recogniser: a " << feature.size() << "-D feature for a model of " << model_.feature_mean.size());
+  const Eigen::VectorXd x = (feature - model_.feature_mean).cwiseQuotient(model_.feature_scale);
+  RegionPrediction p;
+  p.valid = true;
+  p.plane_probability = 1.0 / (1.0 + std::exp(-model_.classifier(x)));
+  const Eigen::Vector3d n(model_.normal[0](x), model_.normal[1](x), model_.normal[2](x));
+  if (n.norm() > 1e-9) p.normal = n.normalized();
+  return p;
+}
+
+RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& region) const {
+  const RecogniserOptions& o = model_.options;
+  const RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());
+  RegionPrediction p;
+  if (r.points >= o.min_points) p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
+  p.points = r.points;
+  return p;
+}
+
+}  // namespace pdvo

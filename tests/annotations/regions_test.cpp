@@ -1,0 +1,99 @@
+#include "pdvo/annotations/regions.h"
+
+#include <gtest/gtest.h>
+
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+// A 400x200 image: an L-shaped plane on the left, a non-plane square on the right, an unknown-label strip.
+Annotation Scene() {
+  Annotation a;
+  a.image_path = "x.png";
+  a.image_width = 400;
+  a.image_height = 200;
+  AnnotationShape plane;
+  plane.label = kPlaneLabel;
+  plane.points = {{0, 0}, {199, 0}, {199, 79}, {79, 79}, {79, 199}, {0, 199}};
+  plane.normal = Eigen::Vector3d(0, 0, -1);
+  AnnotationShape other;
+  other.label = kNonPlaneLabel;
+  other.points = {{250, 50}, {349, 50}, {349, 149}, {250, 149}};
+  AnnotationShape sky;
+  sky.label = "sky";
+  sky.points = {{200, 0}, {399, 0}, {399, 20}};
+  a.shapes = {plane, other, sky};
+  return a;
+}
+
+TEST(Regions, WholeShapesAndPureWindowsAtTheWorkingSize) {
+  const Annotation a = Scene();
+  for (const cv::Size size : {cv::Size(400, 200), cv::Size(200, 100)}) {
+    const double s = size.width / 400.0;
+    RegionSamplingOptions o;
+    o.min_window = 10;
+    o.min_shape_area = 0;
+    std::mt19937_64 rng(3);
+    const std::vector<LabelledRegion> regions = SampleRegions(a, size, o, rng);
+    const AnnotationMasks masks = Rasterise(a, size);
+    int whole = 0, windows = 0;
+    for (const LabelledRegion& r : regions) {
+      ASSERT_GE(r.shape, 0);
+      ASSERT_LT(r.shape, 2) << "the unknown label is skipped";
+      EXPECT_EQ(r.planar, r.shape == 0);
+      EXPECT_EQ(r.normal.has_value(), r.shape == 0);
+      if (r.whole_shape) {
+        ++whole;
+        const double expected = r.shape == 0 ? 200 * 80 + 80 * 120 : 100 * 100;
+        EXPECT_NEAR(r.region.Area(), expected * s * s, expected * s * s * 0.02);
+        continue;
+      }
+      ++windows;
+      EXPECT_TRUE(r.region.mask.empty());
+      EXPECT_EQ(r.region.box.width, r.region.box.height);
+      EXPECT_GE(r.region.box.width, o.min_window);
+      // Pure: every pixel of the window carries the shape's label.
+      const cv::Mat labels = masks.label(r.region.box);
+      const uchar want = r.planar ? kMaskPlane : kMaskNonPlane;
+      EXPECT_EQ(cv::countNonZero(labels != want), 0) << r.region.box;
+    }
+    EXPECT_EQ(whole, 2);
+    EXPECT_EQ(windows, 2 * o.windows_per_shape);
+  }
+}
+
+TEST(Regions, SameSeedSameRegionsAndContainsFollowsTheMask) {
+  const Annotation a = Scene();
+  RegionSamplingOptions o;
+  std::mt19937_64 r1(9), r2(9), r3(10);
+  const auto a1 = SampleRegions(a, {400, 200}, o, r1), a2 = SampleRegions(a, {400, 200}, o, r2),
+             a3 = SampleRegions(a, {400, 200}, o, r3);
+  ASSERT_EQ(a1.size(), a2.size());
+  bool differs = a1.size() != a3.size();
+  for (size_t i = 0; i < a1.size(); ++i) {
+    EXPECT_EQ(a1[i].region.box, a2[i].region.box);
+    differs = differs || (i < a3.size() && a1[i].region.box != a3[i].region.box);
+  }
+  EXPECT_TRUE(differs);
+  const Region& l = a1.front().region;  // the L-shaped plane
+  ASSERT_TRUE(a1.front().whole_shape);
+  EXPECT_TRUE(l.Contains({10, 150}));
+  EXPECT_TRUE(l.Contains({150, 10}));
+  EXPECT_FALSE(l.Contains({150, 150}));  // inside the box, outside the L
+  EXPECT_FALSE(l.Contains({300, 100}));
+}
+
+TEST(Regions, SmallShapesAreSkippedAndBadOptionsThrow) {
+  const Annotation a = Scene();
+  RegionSamplingOptions o;
+  o.min_shape_area = 30000;  // larger than both shapes (25600 and 10000 px) at 400x200
+  std::mt19937_64 rng(1);
+  EXPECT_TRUE(SampleRegions(a, {400, 200}, o, rng).empty());
+  o.min_window = 2;
+  EXPECT_THROW(SampleRegions(a, {400, 200}, o, rng), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo

@@ -1,0 +1,104 @@
+#include "pdvo/infer/model.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/infer/recogniser.h"
+#include "pdvo/test/support.h"
+
+namespace pdvo {
+namespace {
+
+RvmFunction RandomRvm(int vectors, int dims, std::mt19937& rng) {
+  std::normal_distribution<double> g(0, 1);
+  RvmFunction f;
+  f.gamma = 0.37;
+  f.bias = g(rng);
+  f.weights = Eigen::VectorXd::NullaryExpr(vectors, [&]() { return g(rng); });
+  f.vectors = Eigen::MatrixXd::NullaryExpr(vectors, dims, [&]() { return g(rng); });
+  return f;
+}
+
+// A small model with random contents: 12 gradient words, 5 colour words, 3 topics.
+PlaneModel RandomModel() {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  cv::Mat g(12, kGradientDims, CV_32F), c(5, kColourDims, CV_32F);
+  cv::randu(g, 0, 100);
+  cv::randu(c, 0, 1);
+  PlaneModel m;
+  m.gradient_words = Vocabulary(g);
+  m.colour_words = Vocabulary(c);
+  m.topics = Eigen::MatrixXd::NullaryExpr(17, 3, [&]() { return u(rng); });
+  const int dims = 6 * 3 + 6 * kOrientationBins;
+  m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
+  m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
+  m.classifier = RandomRvm(4, dims, rng);
+  for (RvmFunction& f : m.normal) f = RandomRvm(3, dims, rng);
+  m.card.data = "synthetic streets";
+  m.card.images = 7;
+  m.card.cv_accuracy = 0.93;
+  return m;
+}
+
+TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
+  const PlaneModel m = RandomModel();
+  const test::TempDir dir;
+  const std::string path = dir.str() + "/model.yml";
+  m.Write(path);
+  const PlaneModel back = PlaneModel::Read(path);
+  EXPECT_EQ(back.ToYaml(), ReadFile(path));  // re-writing a read model gives the same bytes
+  EXPECT_EQ(back.card.data, "synthetic streets");
+  EXPECT_EQ(back.card.images, 7);
+  EXPECT_EQ(back.options, m.options);
+  EXPECT_EQ(back.topics, m.topics);  // doubles round trip exactly
+  std::mt19937 rng(2);
+  std::normal_distribution<double> g(0, 1);
+  const Eigen::VectorXd x = Eigen::VectorXd::NullaryExpr(m.feature_mean.size(), [&]() { return g(rng); });
+  EXPECT_EQ(back.classifier(x), m.classifier(x));
+  const RegionPrediction a = Recogniser(m).Predict(x), b = Recogniser(back).Predict(x);
+  EXPECT_EQ(a.plane_probability, b.plane_probability);
+  EXPECT_EQ(a.normal, b.normal);
+  EXPECT_NEAR(a.normal.norm(), 1.0, 1e-12);
+}
+
+TEST(Model, RvmFunctionIsTheKernelExpansion) {
+  RvmFunction f;
+  f.gamma = 0.5;
+  f.bias = 0.25;
+  f.weights = Eigen::Vector2d(2, -1);
+  f.vectors = Eigen::MatrixXd(2, 2);
+  f.vectors << 0, 0, 1, 1;
+  const Eigen::Vector2d x(1, 0);  // squared distances 1 and 1
+  EXPECT_NEAR(f(x), 2 * std::exp(-0.5) - std::exp(-0.5) - 0.25, 1e-15);
+}
+
+TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
+  const std::string text = RandomModel().ToYaml();
+  const auto message_of = [](const std::string& yaml) {
+    try {
+      PlaneModel::FromYaml(yaml, "m.yml");
+    } catch (const FormatError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string other = text;
+  other.replace(other.find("version: 1"), 10, "version: 7");
+  EXPECT_NE(message_of(other).find("model version 7, this build reads version 1"), std::string::npos)
+      << message_of(other);
+  // Cut at a line boundary (valid YAML, no end marker) and in the middle of a matrix.
+  const std::string at_line = text.substr(0, text.rfind('\n', text.size() / 2) + 1);
+  EXPECT_NE(message_of(at_line).find("m.yml"), std::string::npos);
+  EXPECT_NE(message_of(at_line), "no error");
+  EXPECT_NE(message_of(text.substr(0, text.size() * 3 / 4)), "no error");
+  EXPECT_NE(message_of("%YAML:1.0\n---\nformat: something-else\n").find("not a pdvo-plane-model"), std::string::npos);
+  EXPECT_NE(message_of("not yaml at all: [").find("m.yml"), std::string::npos);
+  EXPECT_THROW(PlaneModel::Read("/nonexistent/model.yml"), IoError);
+}
+
+}  // namespace
+}  // namespace pdvo

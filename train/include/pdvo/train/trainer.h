@@ -1,0 +1,69 @@
+// Training the plane recogniser (the paper's section III): regions sampled from annotations -> salient points
+// and descriptors -> two vocabularies (k-means) -> word histograms -> topics (orthogonal NMF) -> spatiograms ->
+// an RVM classifier and three RVM normal regressors (dlib, Tipping & Faul), kernel widths chosen by
+// cross-validation grouped by image -> one PlaneModel.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pdvo/annotations/regions.h"
+#include "pdvo/infer/model.h"
+#include "pdvo/train/onmf.h"
+
+namespace pdvo {
+
+struct RvmOptions {
+  // RBF kernel widths tried, gamma = value / feature dimensions (features are standardised).
+  std::vector<double> gammas = {0.05, 0.15, 0.5, 1.5};
+  double epsilon = 1e-3;  // dlib's stopping tolerance
+  int max_iterations = 2000;
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("gammas", self.gammas);
+    visit("epsilon", self.epsilon);
+    visit("max_iterations", self.max_iterations);
+  }
+  bool Check() const;
+  bool operator==(const RvmOptions&) const = default;
+};
+
+struct TrainOptions {
+  RecogniserOptions recogniser;
+  RegionSamplingOptions regions;
+  int gradient_words = 300;
+  int colour_words = 60;
+  int vocabulary_samples = 40000;  // descriptors drawn (per vocabulary) for k-means
+  int kmeans_iterations = 20;
+  OnmfOptions topics;
+  // Training cost grows with the cube of the sample count: regions are drawn at random up to these bounds.
+  int max_regions_per_class = 600;  // classes are balanced to the smaller class, at most this many each
+  int max_normal_regions = 800;     // planes with normals for the regressors
+  RvmOptions rvm;
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("recogniser", self.recogniser);
+    visit("regions", self.regions);
+    visit("gradient_words", self.gradient_words);
+    visit("colour_words", self.colour_words);
+    visit("vocabulary_samples", self.vocabulary_samples);
+    visit("kmeans_iterations", self.kmeans_iterations);
+    visit("topics", self.topics);
+    visit("max_regions_per_class", self.max_regions_per_class);
+    visit("max_normal_regions", self.max_normal_regions);
+    visit("rvm", self.rvm);
+  }
+  bool Check() const;
+  bool operator==(const TrainOptions&) const = default;
+};
+
+// Trains on the annotation files (LabelMe JSON with images beside them). `folds` >= 2 cross-validates the
+// kernel widths (folds grouped by image); 1 takes the first width of each list. Throws pdvo::Error for no
+// files, a missing image, or a class without examples. The same files, options and seed give the same model.
+PlaneModel TrainModel(const std::vector<std::string>& annotation_files, const TrainOptions& options, uint64_t seed,
+                      int folds, const std::string& data_description);
+
+}  // namespace pdvo

@@ -1,0 +1,310 @@
+#include "pdvo/train/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
+#include "pdvo/common/options.h"
+#include "pdvo/eval/recognition.h"
+#include "pdvo/infer/recogniser.h"
+#include "pdvo/train/sparse_bayes.h"
+#include "rvm.h"
+
+namespace pdvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+struct SampledRegion {
+  int image = 0;
+  LabelledRegion labelled;
+  RegionWords words;
+};
+
+// Rows `rows` of `descriptors` of every image, stacked.
+cv::Mat DrawDescriptors(const std::vector<Features>& features, bool gradient, int count, std::mt19937_64& rng) {
+  std::vector<std::pair<int, int>> all;
+  for (size_t i = 0; i < features.size(); ++i) {
+    for (size_t r = 0; r < features[i].size(); ++r) all.emplace_back(static_cast<int>(i), static_cast<int>(r));
+  }
+  std::shuffle(all.begin(), all.end(), rng);
+  if (static_cast<int>(all.size()) > count) all.resize(count);
+  std::sort(all.begin(), all.end());
+  cv::Mat out(static_cast<int>(all.size()), gradient ? kGradientDims : kColourDims, CV_32F);
+  for (size_t k = 0; k < all.size(); ++k) {
+    const Features& f = features[all[k].first];
+    (gradient ? f.gradient : f.colour).row(all[k].second).copyTo(out.row(static_cast<int>(k)));
+  }
+  return out;
+}
+
+// Cross-validation folds grouped by image: the images are shuffled and dealt round the folds.
+std::vector<int> FoldOfImage(int images, int folds, std::mt19937_64& rng) {
+  std::vector<int> order(images);
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<int> fold(images);
+  for (int k = 0; k < images; ++k) fold[order[k]] = k % std::max(1, folds);
+  return fold;
+}
+
+Eigen::MatrixXd Rows(const Eigen::MatrixXd& x, const std::vector<int>& rows) {
+  Eigen::MatrixXd out(rows.size(), x.cols());
+  for (size_t i = 0; i < rows.size(); ++i) out.row(i) = x.row(rows[i]);
+  return out;
+}
+
+template <class T>
+std::vector<T> Pick(const std::vector<T>& v, const std::vector<int>& rows) {
+  std::vector<T> out;
+  for (int r : rows) out.push_back(v[r]);
+  return out;
+}
+
+Eigen::Vector3d PredictNormal(const std::array<RvmFunction, 3>& f, const Eigen::VectorXd& x) {
+  const Eigen::Vector3d n(f[0](x), f[1](x), f[2](x));
+  return n.norm() > 1e-9 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d(0, 0, -1);
+}
+
+std::array<RvmFunction, 3> TrainNormal(const Eigen::MatrixXd& x, const std::vector<Eigen::Vector3d>& normals,
+                                       double gamma, const RvmOptions& o) {
+  std::array<RvmFunction, 3> f;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> t;
+    for (const auto& n : normals) t.push_back(n[c]);
+    f[c] = TrainSparseBayesRegression(x, Eigen::Map<const Eigen::VectorXd>(t.data(), x.rows()),
+                                      {gamma, o.max_iterations, 1e-6});
+  }
+  return f;
+}
+
+// Splits row indices into (train, test) for fold `k`.
+void Split(const std::vector<int>& image_of_row, const std::vector<int>& fold_of_image, int k,
+           std::vector<int>* train, std::vector<int>* test) {
+  train->clear();
+  test->clear();
+  for (size_t r = 0; r < image_of_row.size(); ++r) {
+    (fold_of_image[image_of_row[r]] == k ? test : train)->push_back(static_cast<int>(r));
+  }
+}
+
+}  // namespace
+
+bool RvmOptions::Check() const {
+  PDVO_CHECK_OPTION(!gammas.empty());
+  PDVO_CHECK_OPTION(std::all_of(gammas.begin(), gammas.end(), [](double g) { return g > 0; }));
+  PDVO_CHECK_OPTION(epsilon > 0 && max_iterations >= 1);
+  return true;
+}
+
+bool TrainOptions::Check() const {
+  PDVO_CHECK_OPTION(recogniser.Check() && regions.Check() && topics.Check() && rvm.Check());
+  PDVO_CHECK_OPTION(gradient_words >= 2 && colour_words >= 2);
+  PDVO_CHECK_OPTION(vocabulary_samples >= std::max(gradient_words, colour_words));
+  PDVO_CHECK_OPTION(kmeans_iterations >= 1);
+  PDVO_CHECK_OPTION(max_regions_per_class >= 2 && max_normal_regions >= 0);
+  return true;
+}
+
+PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions& o, uint64_t seed, int folds,
+                      const std::string& data_description) {
+  CheckOptionsOrThrow(o, "training options");
+  PDVO_THROW_CHECK(!files.empty(), InvalidArgument, "train: no annotation files");
+  PDVO_THROW_CHECK(folds >= 1, InvalidArgument, "train: --cv must be at least 1");
+  std::mt19937_64 rng(seed);
+  const Clock::time_point start = Clock::now();
+
+  // 1. Images -> salient points, descriptors and sampled regions.
+  Clock::time_point stage = Clock::now();
+  std::vector<Features> features;
+  std::vector<SampledRegion> regions;
+  {
+    Progress progress("describing images", files.size());
+    for (size_t i = 0; i < files.size(); ++i) {
+      const AnnotatedImage a = ReadAnnotatedImage(files[i], o.recogniser.working_width);
+      features.push_back(ExtractFeatures(a.image, o.recogniser.features));
+      for (LabelledRegion& r : SampleRegions(a.annotation, a.image.size(), o.regions, rng)) {
+        regions.push_back({static_cast<int>(i), std::move(r), {}});
+      }
+      progress.Step();
+    }
+  }
+  size_t descriptor_count = 0;
+  for (const Features& f : features) descriptor_count += f.size();
+  PDVO_LOG(Info) << "[time] described " << files.size() << " images (" << descriptor_count << " points, "
+                 << regions.size() << " regions) in " << Since(stage) << " s";
+
+  // 2. Vocabularies.
+  stage = Clock::now();
+  PDVO_THROW_CHECK(static_cast<int>(descriptor_count) >= std::max(o.gradient_words, o.colour_words), InvalidArgument,
+                   "train: " << descriptor_count << " salient points in all images, fewer than the vocabulary size");
+  const Vocabulary gradient_words =
+      Vocabulary::Build(DrawDescriptors(features, true, o.vocabulary_samples, rng), o.gradient_words, seed,
+                        o.kmeans_iterations);
+  const Vocabulary colour_words =
+      Vocabulary::Build(DrawDescriptors(features, false, o.vocabulary_samples, rng), o.colour_words, seed + 1,
+                        o.kmeans_iterations);
+  std::vector<ImageWords> words;
+  for (const Features& f : features) words.push_back(QuantiseFeatures(f, gradient_words, colour_words));
+  features.clear();
+  PDVO_LOG(Info) << "[time] vocabularies of " << o.gradient_words << " gradient and " << o.colour_words
+                 << " colour words in " << Since(stage) << " s";
+
+  // 3. Region words; regions with too few points are dropped; classes balanced; normals drawn.
+  std::vector<int> planes, non_planes, normals;
+  for (size_t k = 0; k < regions.size(); ++k) {
+    SampledRegion& r = regions[k];
+    r.words = CollectRegionWords(words[r.image], r.labelled.region, o.gradient_words, o.colour_words);
+    if (r.words.points < o.recogniser.min_points) continue;
+    (r.labelled.planar ? planes : non_planes).push_back(static_cast<int>(k));
+    if (r.labelled.planar && r.labelled.normal) normals.push_back(static_cast<int>(k));
+  }
+  PDVO_THROW_CHECK(!planes.empty(), InvalidArgument,
+                   "train: no plane regions with at least " << o.recogniser.min_points << " salient points");
+  PDVO_THROW_CHECK(!non_planes.empty(), InvalidArgument,
+                   "train: no non-plane regions with at least " << o.recogniser.min_points << " salient points");
+  const size_t per_class = std::min({planes.size(), non_planes.size(), static_cast<size_t>(o.max_regions_per_class)});
+  for (std::vector<int>* v : {&planes, &non_planes, &normals}) std::shuffle(v->begin(), v->end(), rng);
+  planes.resize(per_class);
+  non_planes.resize(per_class);
+  if (normals.size() > static_cast<size_t>(o.max_normal_regions)) normals.resize(o.max_normal_regions);
+  std::vector<int> classified = planes;
+  classified.insert(classified.end(), non_planes.begin(), non_planes.end());
+  std::sort(classified.begin(), classified.end());
+  std::sort(normals.begin(), normals.end());
+  std::vector<int> used;  // every region that trains something
+  std::set_union(classified.begin(), classified.end(), normals.begin(), normals.end(), std::back_inserter(used));
+  PDVO_LOG(Info) << "training regions: " << per_class << " planes, " << per_class << " non-planes, "
+                 << normals.size() << " with normals";
+
+  // 4. Topics by orthogonal NMF of the training regions' word histograms.
+  stage = Clock::now();
+  const int total_words = o.gradient_words + o.colour_words;
+  Eigen::MatrixXd histograms(total_words, used.size());
+  for (size_t k = 0; k < used.size(); ++k) histograms.col(k) = regions[used[k]].words.histogram;
+  OnmfOptions topic_options = o.topics;
+  topic_options.seed = seed;
+  PDVO_THROW_CHECK(static_cast<int>(used.size()) >= topic_options.topics, InvalidArgument,
+                   "train: " << used.size() << " training regions, fewer than the " << topic_options.topics
+                             << " topics");
+  const OnmfResult topics = FactoriseOrthogonal(histograms, topic_options);
+  PDVO_LOG(Info) << "[time] " << topic_options.topics << " topics (relative error "
+                 << (topics.errors.empty() ? 0.0 : topics.errors.back()) << ") in " << Since(stage) << " s";
+
+  // 5. Spatiogram features, standardised.
+  stage = Clock::now();
+  std::vector<Eigen::VectorXd> raw(regions.size());
+  for (int k : used) raw[k] = RegionFeature(regions[k].words, topics.basis, o.recogniser.topic_iterations);
+  const Eigen::Index dims = raw[used.front()].size();
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(dims), var = Eigen::VectorXd::Zero(dims);
+  for (int k : used) mean += raw[k];
+  mean /= used.size();
+  for (int k : used) var += (raw[k] - mean).cwiseAbs2();
+  const Eigen::VectorXd scale = (var / used.size()).cwiseSqrt().cwiseMax(1e-6);
+  auto matrix_of = [&](const std::vector<int>& rows) {
+    Eigen::MatrixXd x(rows.size(), dims);
+    for (size_t i = 0; i < rows.size(); ++i) x.row(i) = (raw[rows[i]] - mean).cwiseQuotient(scale).transpose();
+    return x;
+  };
+  PDVO_LOG(Info) << "[time] " << used.size() << " region features (" << dims << "-D) in " << Since(stage) << " s";
+
+  // 6. RVMs, with kernel widths chosen by cross-validation grouped by image.
+  const std::vector<int> fold_of_image = FoldOfImage(static_cast<int>(files.size()), folds, rng);
+  const RvmOptions& rvm = o.rvm;
+  auto gamma_of = [&](double g) { return g / static_cast<double>(dims); };
+
+  stage = Clock::now();
+  const Eigen::MatrixXd xc = matrix_of(classified);
+  std::vector<double> labels;
+  std::vector<int> image_c;
+  for (int k : classified) {
+    labels.push_back(regions[k].labelled.planar ? 1.0 : -1.0);
+    image_c.push_back(regions[k].image);
+  }
+  double best_gamma = rvm.gammas.front(), best_accuracy = -1;
+  if (folds >= 2) {
+    for (double g : rvm.gammas) {
+      int correct = 0, tested = 0;
+      std::vector<int> train, test;
+      for (int f = 0; f < folds; ++f) {
+        Split(image_c, fold_of_image, f, &train, &test);
+        const std::vector<double> train_labels = Pick(labels, train);
+        if (test.empty() || std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
+            std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
+          continue;
+        }
+        const RvmFunction fn = internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g), rvm.epsilon,
+                                                            rvm.max_iterations);
+        for (int r : test) correct += (fn(xc.row(r).transpose()) >= 0) == (labels[r] > 0), ++tested;
+      }
+      const double accuracy = tested ? static_cast<double>(correct) / tested : 0;
+      PDVO_LOG(Info) << "classifier cv: gamma " << g << "/D accuracy " << accuracy;
+      if (accuracy > best_accuracy) best_accuracy = accuracy, best_gamma = g;
+    }
+  }
+  PlaneModel model;
+  model.classifier = internal::TrainRvmClassifier(xc, labels, gamma_of(best_gamma), rvm.epsilon, rvm.max_iterations);
+  PDVO_LOG(Info) << "[time] classifier (gamma " << best_gamma << "/D, " << model.classifier.size()
+                 << " relevance vectors) in " << Since(stage) << " s";
+
+  stage = Clock::now();
+  double best_normal_gamma = rvm.gammas.front(), best_error = -1;
+  const Eigen::MatrixXd xn = matrix_of(normals);
+  std::vector<Eigen::Vector3d> targets;
+  std::vector<int> image_n;
+  for (int k : normals) {
+    targets.push_back(*regions[k].labelled.normal);
+    image_n.push_back(regions[k].image);
+  }
+  if (!normals.empty()) {
+    if (folds >= 2) {
+      for (double g : rvm.gammas) {
+        double sum = 0;
+        int tested = 0;
+        std::vector<int> train, test;
+        for (int f = 0; f < folds; ++f) {
+          Split(image_n, fold_of_image, f, &train, &test);
+          if (test.empty() || train.empty()) continue;
+          const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
+          for (int r : test) sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose())), ++tested;
+        }
+        const double error = tested ? sum / tested : 180;
+        PDVO_LOG(Info) << "normal cv: gamma " << g << "/D mean error " << error << " deg";
+        if (best_error < 0 || error < best_error) best_error = error, best_normal_gamma = g;
+      }
+    }
+    model.normal = TrainNormal(xn, targets, gamma_of(best_normal_gamma), rvm);
+  } else {
+    PDVO_LOG(Warning) << "no plane regions with normals: the model predicts no orientation";
+    for (RvmFunction& f : model.normal) f.gamma = gamma_of(best_normal_gamma);
+  }
+  PDVO_LOG(Info) << "[time] normal regressors (gamma " << best_normal_gamma << "/D, " << model.normal[0].size()
+                 << "+" << model.normal[1].size() << "+" << model.normal[2].size() << " relevance vectors) in "
+                 << Since(stage) << " s";
+
+  model.options = o.recogniser;
+  model.gradient_words = gradient_words;
+  model.colour_words = colour_words;
+  model.topics = topics.basis;
+  model.feature_mean = mean;
+  model.feature_scale = scale;
+  model.card.data = data_description;
+  model.card.images = static_cast<int>(files.size());
+  model.card.plane_regions = static_cast<int>(per_class);
+  model.card.non_plane_regions = static_cast<int>(per_class);
+  model.card.normal_regions = static_cast<int>(normals.size());
+  model.card.folds = folds;
+  model.card.cv_accuracy = std::max(0.0, best_accuracy);
+  model.card.cv_normal_error = std::max(0.0, best_error);
+  model.card.seed = static_cast<int>(seed);
+  PDVO_LOG(Info) << "[time] trained in " << Since(start) << " s";
+  return model;
+}
+
+}  // namespace pdvo
