@@ -1,4 +1,6 @@
 // pdvo train --annotations DIR... --out MODEL: trains the plane recogniser into one versioned model file.
+#include <sys/resource.h>
+
 #include <sstream>
 
 #include "pdvo/common/errors.h"
@@ -37,11 +39,13 @@ int RunTrain(int argc, char** argv) {
   PDVO_LOG(Info) << "training on " << files.size() << " annotation files";
   const PlaneModel model = TrainModel(files, options, seed, folds, data.str());
   model.Write(out_path);
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
   std::printf("wrote %s: %d images, %d+%d regions, cv accuracy %.3f, cv normal error %.1f deg, relevance vectors "
-              "%d (classifier) %d/%d/%d (normal)\n",
+              "%d (classifier) %d/%d/%d (normal); peak memory %.0f MiB\n",
               out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
               model.card.cv_accuracy, model.card.cv_normal_error, model.classifier.size(), model.normal[0].size(),
-              model.normal[1].size(), model.normal[2].size());
+              model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
   return 0;
 }
 

@@ -196,3 +196,77 @@ TEST(Cli, SynthWritesASequenceAndRejectsUnknownOptions) {
 
 }  // namespace
 }  // namespace pdvo
+
+namespace pdvo {
+namespace {
+
+// A small end-to-end run: train on one generated street, evaluate on another (a seed not used in training).
+TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
+  test::TempDir dir;
+  const std::string frames = " -n 40 --set walk.fps=3 -v warning";
+  ASSERT_EQ(Pdvo("synth -o " + (dir / "train") + " --seed 11" + frames, dir).code, 0);
+  ASSERT_EQ(Pdvo("synth -o " + (dir / "test") + " --seed 12 -n 20 --set walk.fps=3 -v warning", dir).code, 0);
+  const std::string small =
+      " --set gradient_words=60 --set colour_words=16 --set topics.topics=8 --set vocabulary_samples=5000"
+      " --set max_regions_per_class=120 --set max_normal_regions=120 --set rvm.gammas=0.5 --cv 2 -v warning";
+  const CommandResult t = Pdvo("train -a " + (dir / "train/annotations") + " -o " + (dir / "m.yml") + small, dir);
+  ASSERT_EQ(t.code, 0) << t.err;
+  EXPECT_NE(t.out.find("wrote"), std::string::npos);
+  // The same seed gives the same model, byte for byte.
+  ASSERT_EQ(Pdvo("train -a " + (dir / "train/annotations") + " -o " + (dir / "m2.yml") + small, dir).code, 0);
+  EXPECT_EQ(ReadFile(dir / "m.yml"), ReadFile(dir / "m2.yml"));
+
+  const CommandResult e = Pdvo("evaluate -m " + (dir / "m.yml") + " -a " + (dir / "test/annotations") + " --json " +
+                                   (dir / "report.json") + " -v warning",
+                               dir);
+  ASSERT_EQ(e.code, 0) << e.err;
+  const nlohmann::json report = nlohmann::json::parse(ReadFile(dir / "report.json"));
+  const nlohmann::json& overall = report["overall"];
+  EXPECT_GT(overall["regions"].get<int>(), 100);
+  EXPECT_EQ(report["per_image"].size(), 20u);
+  // Chance is 0.5 balanced accuracy and about 60 degrees of normal error on these streets.
+  EXPECT_GT(overall["balanced_accuracy"].get<double>(), 0.85) << e.out;
+  EXPECT_GT(overall["roc_auc"].get<double>(), 0.9) << e.out;
+  EXPECT_LT(overall["normal_error_deg"]["mean"].get<double>(), 35) << e.out;
+}
+
+TEST(Cli, TrainAndEvaluateRejectBadInputs) {
+  test::TempDir dir;
+  const auto expect_error = [&](const std::string& args, const std::string& text) {
+    const CommandResult r = Pdvo(args, dir);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(text), std::string::npos) << args << ": " << r.err;
+  };
+  fs::create_directories(dir / "empty");
+  expect_error("train -a " + (dir / "empty") + " -o " + (dir / "m.yml"), "empty");
+  // One image, planes only: no non-plane examples.
+  cv::Mat image(120, 160, CV_8UC3);
+  cv::randu(image, 0, 255);
+  fs::create_directories(dir / "planes");
+  WriteImage(dir / "planes/img.png", image);
+  Annotation a;
+  a.image_path = "img.png";
+  a.image_width = 160;
+  a.image_height = 120;
+  AnnotationShape s;
+  s.label = kPlaneLabel;
+  s.points = {{5, 5}, {150, 5}, {150, 110}, {5, 110}};
+  s.normal = Eigen::Vector3d(0, 0, -1);
+  a.shapes = {s};
+  WriteAnnotation(dir / "planes/a.json", a);
+  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
+               "no non-plane regions");
+  // A missing image.
+  a.image_path = "gone.png";
+  fs::create_directories(dir / "missing");
+  WriteAnnotation(dir / "missing/a.json", a);
+  expect_error("train -a " + (dir / "missing") + " -o " + (dir / "m.yml") + " -v error", "gone.png: file not found");
+  EXPECT_FALSE(fs::exists(dir / "m.yml"));
+  // A model of another version.
+  WriteFileAtomically(dir / "old.yml", "%YAML:1.0\n---\nformat: pdvo-plane-model\nversion: 0\n");
+  expect_error("evaluate -m " + (dir / "old.yml") + " -a " + (dir / "planes"), "model version 0");
+}
+
+}  // namespace
+}  // namespace pdvo

@@ -16,9 +16,9 @@ namespace pdvo {
 
 struct RvmOptions {
   // RBF kernel widths tried, gamma = value / feature dimensions (features are standardised).
-  std::vector<double> gammas = {0.05, 0.15, 0.5, 1.5};
-  double epsilon = 1e-3;  // dlib's stopping tolerance
-  int max_iterations = 2000;
+  std::vector<double> gammas = {0.5, 1.5};
+  double epsilon = 1e-3;      // dlib's stopping tolerance (classifier)
+  int max_iterations = 400;   // classifier iterations; normal regressors: steps (bounds their relevance vectors)
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -40,7 +40,7 @@ struct TrainOptions {
   OnmfOptions topics;
   // Training cost grows with the cube of the sample count: regions are drawn at random up to these bounds.
   int max_regions_per_class = 600;  // classes are balanced to the smaller class, at most this many each
-  int max_normal_regions = 800;     // planes with normals for the regressors
+  int max_normal_regions = 400;     // planes with normals for the regressors
   RvmOptions rvm;
 
   template <class Self, class V>

@@ -21,7 +21,7 @@ class Vocabulary {
   explicit Vocabulary(cv::Mat centres);
 
   // The nearest word of each row (FLANN kd-tree with `checks` leaves visited; exact for small vocabularies).
-  std::vector<int> Quantise(const cv::Mat& descriptors, int checks = 64) const;
+  std::vector<int> Quantise(const cv::Mat& descriptors, int checks = 16) const;
   // Normalised histogram (sums to 1) of the words of `descriptors`; zeros if there are none.
   cv::Mat Histogram(const cv::Mat& descriptors) const;
 
