@@ -3,7 +3,9 @@
 // recognising one 100x100 region of a described frame. Model: argv --model=PATH (default models/default).
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <cstring>
+#include <memory>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -26,10 +28,9 @@ cv::Mat StreetFrame() {
   return frame.image;
 }
 
-const pdvo::Recogniser& Model() {
-  static const pdvo::Recogniser recogniser(pdvo::PlaneModel::Read(g_model_path));
-  return recogniser;
-}
+std::unique_ptr<pdvo::Recogniser> g_recogniser;
+
+const pdvo::Recogniser& Model() { return *g_recogniser; }
 
 void BM_DescribeFrame(benchmark::State& state) {
   const cv::Mat image = StreetFrame();
@@ -78,6 +79,12 @@ BENCHMARK(BM_RecogniseRegion100)->Unit(benchmark::kMicrosecond);
 int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--model=", 8) == 0) g_model_path = argv[i] + 8;
+  }
+  try {
+    g_recogniser = std::make_unique<pdvo::Recogniser>(pdvo::PlaneModel::Read(g_model_path));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "recogniser_bench: %s\n", e.what());
+    return 2;
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
