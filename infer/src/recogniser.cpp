@@ -93,6 +93,10 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
 Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
   PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(),
                    InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
+  const Eigen::Index dims = 6 * (model_.topics.cols() + kOrientationBins);
+  const bool classifier_fits = model_.classifier.size() == 0 || model_.classifier.vectors.cols() == dims;
+  PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifier_fits, InvalidArgument,
+                   "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
 
 ImageWords Recogniser::Describe(const cv::Mat& image) const {

@@ -42,12 +42,4 @@ RvmFunction TrainRvmClassifier(const Eigen::MatrixXd& x, const std::vector<doubl
   return FromDlib(trainer.train(ToSamples(x), labels), gamma);
 }
 
-RvmFunction TrainRvmRegressor(const Eigen::MatrixXd& x, const std::vector<double>& targets, double gamma,
-                              double epsilon) {
-  dlib::rvm_regression_trainer<Kernel> trainer;
-  trainer.set_kernel(Kernel(gamma));
-  trainer.set_epsilon(epsilon);
-  return FromDlib(trainer.train(ToSamples(x), targets), gamma);
-}
-
 }  // namespace pdvo::internal

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <numeric>
 #include <random>
-#include <sstream>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"

@@ -4,7 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <optional>
+#include <string>
 #include <vector>
 
 #include "pdvo/annotations/regions.h"
