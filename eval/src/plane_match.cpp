@@ -6,6 +6,7 @@
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/eval/recognition.h"
 
 namespace pdvo {
 namespace {
@@ -86,10 +87,7 @@ PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& est
     m.iou = c.iou;
     const auto& nr = reference.shapes[m.reference_shape].normal;
     const auto& ne = estimate.shapes[m.estimated_shape].normal;
-    if (nr && ne && nr->norm() > 0 && ne->norm() > 0) {
-      const double cosine = std::clamp(nr->normalized().dot(ne->normalized()), -1.0, 1.0);
-      m.normal_angle_deg = std::acos(cosine) * 180.0 / M_PI;
-    }
+    if (nr && ne && nr->norm() > 0 && ne->norm() > 0) m.normal_angle_deg = AngleDegrees(*nr, *ne);
     out.matches.push_back(m);
   }
   return out;

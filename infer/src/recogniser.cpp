@@ -46,30 +46,31 @@ RegionWords CollectRegionWords(const ImageWords& words, const Region& region, in
     const int g = words.gradient[i], c = words.colour[i];
     PDVO_THROW_CHECK(g >= 0 && g < gradient_words && c >= 0 && c < colour_words, InvalidArgument,
                      "region words: a word out of the vocabulary's range");
-    ++r.points;
-    r.ids.push_back(g);
-    r.ids.push_back(gradient_words + c);
-    r.positions.push_back(words.points[i]);
-    r.positions.push_back(words.points[i]);
-    r.orientations.push_back(words.orientation[i]);
+    r.points.push_back(words.points[i]);
+    r.gradient.push_back(g);
+    r.colour.push_back(gradient_words + c);
+    r.orientation.push_back(words.orientation[i]);
     r.histogram[g] += 1;
     r.histogram[gradient_words + c] += 1;
   }
-  if (r.points > 0) r.histogram /= 2.0 * r.points;
+  if (r.size() > 0) r.histogram /= 2.0 * r.size();
   return r;
 }
 
 Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& topics, int topic_iterations) {
+  // Topics: every point contributes its gradient word and its colour word.
+  std::vector<int> ids = region.gradient;
+  ids.insert(ids.end(), region.colour.begin(), region.colour.end());
+  std::vector<cv::Point2f> positions = region.points;
+  positions.insert(positions.end(), region.points.begin(), region.points.end());
   const Eigen::VectorXd weights = ProjectOntoTopics(topics, region.histogram, topic_iterations);
-  const Eigen::VectorXd by_topic = ComputeSpatiogram(topics, region.ids, region.positions, region.box, weights).ToVector();
-  // Orientation bins as words of an identity basis; their weights are the bins' shares of the points.
-  std::vector<cv::Point2f> points;
-  for (size_t i = 0; i < region.positions.size(); i += 2) points.push_back(region.positions[i]);
+  const Eigen::VectorXd by_topic = ComputeSpatiogram(topics, ids, positions, region.box, weights).ToVector();
+  // Orientation bins as the words of an identity basis; their weights are the bins' shares of the points.
   Eigen::VectorXd shares = Eigen::VectorXd::Zero(kOrientationBins);
-  for (int b : region.orientations) shares[b] += 1.0 / region.orientations.size();
+  for (int b : region.orientation) shares[b] += 1.0 / region.size();
   const Eigen::VectorXd by_orientation =
-      ComputeSpatiogram(Eigen::MatrixXd::Identity(kOrientationBins, kOrientationBins), region.orientations, points,
-                        region.box, shares)
+      ComputeSpatiogram(Eigen::MatrixXd::Identity(kOrientationBins, kOrientationBins), region.orientation,
+                        region.points, region.box, shares)
           .ToVector();
   Eigen::VectorXd feature(by_topic.size() + by_orientation.size());
   feature << by_topic, by_orientation;
@@ -120,8 +121,8 @@ RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& re
   const RecogniserOptions& o = model_.options;
   const RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());
   RegionPrediction p;
-  if (r.points >= o.min_points) p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
-  p.points = r.points;
+  if (r.size() >= o.min_points) p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
+  p.points = r.size();
   return p;
 }
 

@@ -3,28 +3,17 @@
 #include <gtest/gtest.h>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/test/annotations.h"
 #include "pdvo/test/support.h"
 
 namespace pdvo {
 namespace {
 
 Annotation TwoShapes() {
-  Annotation a;
-  a.image_path = "x.png";
-  a.image_width = 200;
-  a.image_height = 100;
-  AnnotationShape plane;
-  plane.label = kPlaneLabel;
-  plane.points = {{10, 10}, {89, 10}, {89, 89}, {10, 89}};  // 80x80 pixel centres
-  plane.normal = Eigen::Vector3d(0.6, 0, -0.8);
-  AnnotationShape other;
-  other.label = kNonPlaneLabel;
-  other.points = {{120, 20}, {159, 20}, {159, 59}, {120, 59}};  // 40x40
-  AnnotationShape ignored;
-  ignored.label = "sky";
-  ignored.points = {{0, 0}, {199, 0}, {199, 5}};
-  a.shapes = {plane, other, ignored};
-  return a;
+  return test::ImageAnnotation("x.png", 200, 100,
+                               {test::RectShape(kPlaneLabel, 10, 10, 89, 89, Eigen::Vector3d(0.6, 0, -0.8)),  // 80x80
+                                test::RectShape(kNonPlaneLabel, 120, 20, 159, 59),                          // 40x40
+                                test::Shape("sky", {{0, 0}, {199, 0}, {199, 5}})});
 }
 
 TEST(Raster, MasksCoverExactlyTheShapes) {

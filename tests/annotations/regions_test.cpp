@@ -4,28 +4,17 @@
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/test/annotations.h"
 
 namespace pdvo {
 namespace {
 
 // A 400x200 image: an L-shaped plane on the left, a non-plane square on the right, an unknown-label strip.
 Annotation Scene() {
-  Annotation a;
-  a.image_path = "x.png";
-  a.image_width = 400;
-  a.image_height = 200;
-  AnnotationShape plane;
-  plane.label = kPlaneLabel;
-  plane.points = {{0, 0}, {199, 0}, {199, 79}, {79, 79}, {79, 199}, {0, 199}};
-  plane.normal = Eigen::Vector3d(0, 0, -1);
-  AnnotationShape other;
-  other.label = kNonPlaneLabel;
-  other.points = {{250, 50}, {349, 50}, {349, 149}, {250, 149}};
-  AnnotationShape sky;
-  sky.label = "sky";
-  sky.points = {{200, 0}, {399, 0}, {399, 20}};
-  a.shapes = {plane, other, sky};
-  return a;
+  return test::ImageAnnotation(
+      "x.png", 400, 200,
+      {test::Shape(kPlaneLabel, {{0, 0}, {199, 0}, {199, 79}, {79, 79}, {79, 199}, {0, 199}}, Eigen::Vector3d(0, 0, -1)),
+       test::RectShape(kNonPlaneLabel, 250, 50, 349, 149), test::Shape("sky", {{200, 0}, {399, 0}, {399, 20}})});
 }
 
 TEST(Regions, WholeShapesAndPureWindowsAtTheWorkingSize) {

@@ -9,6 +9,7 @@
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/common/trajectory.h"
+#include "pdvo/test/annotations.h"
 #include "pdvo/test/scenes.h"
 #include "pdvo/test/support.h"
 
@@ -30,6 +31,14 @@ CommandResult Pdvo(const std::string& args, const test::TempDir& dir) {
 }
 
 int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+// `pdvo <args>` must fail with one line on stderr that contains `text`.
+void ExpectError(const std::string& args, const std::string& text, const test::TempDir& dir) {
+  const CommandResult r = Pdvo(args, dir);
+  EXPECT_NE(r.code, 0) << args;
+  EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
+  EXPECT_NE(r.err.find(text), std::string::npos) << args << ": " << r.err;
+}
 
 // A TUM-style RGB-D folder of the ray-cast room: 3 frames, camera.yaml.
 void WriteRoomSequence(const std::string& root) {
@@ -76,12 +85,7 @@ TEST(Cli, UsageAndHelp) {
 
 TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {
   test::TempDir dir;
-  const auto expect_error = [&](const std::string& args, const std::string& text) {
-    const CommandResult r = Pdvo(args, dir);
-    EXPECT_NE(r.code, 0) << args;
-    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
-    EXPECT_NE(r.err.find(text), std::string::npos) << args << ": " << r.err;
-  };
+  const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
   expect_error("show " + (dir / "none.json") + " --out " + (dir / "o.png"), "none.json: file not found");
   WriteFileAtomically(dir / "bad.json", "{ not json");
   expect_error("show " + (dir / "bad.json") + " --out " + (dir / "o.png"), "bad.json: malformed JSON");
@@ -92,15 +96,8 @@ TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {
   WriteImage(dir / "img.png", noise);
   const std::string png = ReadFile(dir / "img.png");
   WriteFileAtomically(dir / "img.png", png.substr(0, png.size() / 2));
-  Annotation a;
-  a.image_path = "img.png";
-  a.image_width = 60;
-  a.image_height = 40;
-  AnnotationShape s;
-  s.label = kPlaneLabel;
-  s.points = {{5, 5}, {30, 5}, {30, 30}};
-  s.normal = Eigen::Vector3d(0, 0, -1);
-  a.shapes = {s};
+  Annotation a = test::ImageAnnotation(
+      "img.png", 60, 40, {test::Shape(kPlaneLabel, {{5, 5}, {30, 5}, {30, 30}}, Eigen::Vector3d(0, 0, -1))});
   WriteAnnotation(dir / "a.json", a);
   expect_error("show " + (dir / "a.json") + " --out " + (dir / "o.png"), "img.png: cannot decode image");
   EXPECT_FALSE(fs::exists(dir / "o.png"));
@@ -224,7 +221,8 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   const nlohmann::json& overall = report["overall"];
   EXPECT_GT(overall["regions"].get<int>(), 100);
   EXPECT_EQ(report["per_image"].size(), 20u);
-  // Chance is 0.5 balanced accuracy and about 60 degrees of normal error on these streets.
+  // Chance is 0.5 balanced accuracy. One constant normal (the training planes' mean) is off by 58 degrees on
+  // average on held-out streets (seeds 201-202 against 101-104, 3 fps, measured over the annotated planes).
   EXPECT_GT(overall["balanced_accuracy"].get<double>(), 0.85) << e.out;
   EXPECT_GT(overall["roc_auc"].get<double>(), 0.9) << e.out;
   EXPECT_LT(overall["normal_error_deg"]["mean"].get<double>(), 35) << e.out;
@@ -232,12 +230,7 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
 
 TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   test::TempDir dir;
-  const auto expect_error = [&](const std::string& args, const std::string& text) {
-    const CommandResult r = Pdvo(args, dir);
-    EXPECT_NE(r.code, 0) << args;
-    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
-    EXPECT_NE(r.err.find(text), std::string::npos) << args << ": " << r.err;
-  };
+  const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
   fs::create_directories(dir / "empty");
   expect_error("train -a " + (dir / "empty") + " -o " + (dir / "m.yml"), "empty");
   // One image, planes only: no non-plane examples.
@@ -245,15 +238,8 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   cv::randu(image, 0, 255);
   fs::create_directories(dir / "planes");
   WriteImage(dir / "planes/img.png", image);
-  Annotation a;
-  a.image_path = "img.png";
-  a.image_width = 160;
-  a.image_height = 120;
-  AnnotationShape s;
-  s.label = kPlaneLabel;
-  s.points = {{5, 5}, {150, 5}, {150, 110}, {5, 110}};
-  s.normal = Eigen::Vector3d(0, 0, -1);
-  a.shapes = {s};
+  Annotation a =
+      test::ImageAnnotation("img.png", 160, 120, {test::RectShape(kPlaneLabel, 5, 5, 150, 110, Eigen::Vector3d(0, 0, -1))});
   WriteAnnotation(dir / "planes/a.json", a);
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
                "no non-plane regions");

@@ -3,25 +3,16 @@
 #include <gtest/gtest.h>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/test/annotations.h"
 
 namespace pdvo {
 namespace {
 
 AnnotationShape Rect(double x0, double y0, double x1, double y1, Eigen::Vector3d normal) {
-  AnnotationShape s;
-  s.label = kPlaneLabel;
-  s.points = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-  s.normal = normal.normalized();
-  return s;
+  return test::RectShape(kPlaneLabel, x0, y0, x1, y1, normal.normalized());
 }
 
-Annotation Frame(std::vector<AnnotationShape> shapes) {
-  Annotation a;
-  a.image_width = 200;
-  a.image_height = 100;
-  a.shapes = std::move(shapes);
-  return a;
-}
+Annotation Frame(std::vector<AnnotationShape> shapes) { return test::ImageAnnotation("", 200, 100, std::move(shapes)); }
 
 TEST(PlaneMatch, IouAndNormalAngleOfKnownShapes) {
   // Reference: two 40x40 squares. Estimate: the first shifted by 20 px (IoU 1/3) and turned by 10 degrees;

@@ -26,7 +26,7 @@ struct SampledRegion {
   RegionWords words;
 };
 
-// Rows `rows` of `descriptors` of every image, stacked.
+// Up to `count` descriptors (gradient or colour) drawn at random from all images, in image order.
 cv::Mat DrawDescriptors(const std::vector<Features>& features, bool gradient, int count, std::mt19937_64& rng) {
   std::vector<std::pair<int, int>> all;
   for (size_t i = 0; i < features.size(); ++i) {
@@ -160,7 +160,7 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (size_t k = 0; k < regions.size(); ++k) {
     SampledRegion& r = regions[k];
     r.words = CollectRegionWords(words[r.image], r.labelled.region, o.gradient_words, o.colour_words);
-    if (r.words.points < o.recogniser.min_points) continue;
+    if (r.words.size() < o.recogniser.min_points) continue;
     (r.labelled.planar ? planes : non_planes).push_back(static_cast<int>(k));
     if (r.labelled.planar && r.labelled.normal) normals.push_back(static_cast<int>(k));
   }

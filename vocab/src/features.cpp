@@ -143,9 +143,9 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
     f.points.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y));
     DescribeGradient(magnitude, angle, c, o.patch_size, f.gradient.ptr<float>(static_cast<int>(i)));
     DescribeColour(lab_sum, c, o.patch_size, f.colour.ptr<float>(static_cast<int>(i)));
-    const int h = o.patch_size / 2;
-    const cv::Vec3d t = tensor_sum.at<cv::Vec3d>(c.y + h + 1, c.x + h + 1) - tensor_sum.at<cv::Vec3d>(c.y - h, c.x + h + 1) -
-                        tensor_sum.at<cv::Vec3d>(c.y + h + 1, c.x - h) + tensor_sum.at<cv::Vec3d>(c.y - h, c.x - h);
+    const int x0 = c.x - half, y0 = c.y - half, x1 = c.x + half + 1, y1 = c.y + half + 1;  // the window
+    const cv::Vec3d t = tensor_sum.at<cv::Vec3d>(y1, x1) - tensor_sum.at<cv::Vec3d>(y0, x1) -
+                        tensor_sum.at<cv::Vec3d>(y1, x0) + tensor_sum.at<cv::Vec3d>(y0, x0);
     double theta = 0.5 * std::atan2(2 * t[2], t[0] - t[1]);  // (-pi/2, pi/2]
     if (theta < 0) theta += CV_PI;
     f.orientation.push_back(static_cast<float>(std::min(theta, CV_PI - 1e-9)));

@@ -30,15 +30,16 @@ ImageWords QuantiseFeatures(const Features& features, const Vocabulary& gradient
 // `image` resized to `working_width` (unchanged if 0 or already that wide); `scale` gets new / old width.
 cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale = nullptr);
 
-// The words of a region's points: each point contributes its gradient word and its colour word (offset past the
-// gradient words), and the normalised histogram of those words.
+// The points of a region with their words (colour words offset past the gradient words) and orientation bins,
+// and the normalised histogram of all their words.
 struct RegionWords {
-  int points = 0;
-  std::vector<int> ids;                // 2 per point
-  std::vector<cv::Point2f> positions;  // 2 per point
-  std::vector<int> orientations;       // 1 per point (the positions of the gradient words)
-  cv::Rect2d box;                      // the region's extent in pixel-edge coordinates
-  Eigen::VectorXd histogram;           // gradient words + colour words, sums to 1 (zero if no points)
+  std::vector<cv::Point2f> points;
+  std::vector<int> gradient;     // per point, in [0, gradient words)
+  std::vector<int> colour;       // per point, in [gradient words, gradient + colour words)
+  std::vector<int> orientation;  // per point, in [0, kOrientationBins)
+  cv::Rect2d box;                // the region's extent in pixel-edge coordinates
+  Eigen::VectorXd histogram;     // gradient words + colour words, sums to 1 (zero if no points)
+  int size() const { return static_cast<int>(points.size()); }
 };
 RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words, int colour_words);
 
