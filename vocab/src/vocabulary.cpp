@@ -93,14 +93,6 @@ std::vector<int> Vocabulary::Quantise(const cv::Mat& descriptors, int checks) co
   return std::vector<int>(indices.begin<int>(), indices.end<int>());
 }
 
-cv::Mat Vocabulary::Histogram(const cv::Mat& descriptors) const {
-  cv::Mat h(1, size(), CV_32F, cv::Scalar(0));
-  const std::vector<int> words = Quantise(descriptors);
-  for (int w : words) h.at<float>(w) += 1.0f;
-  if (!words.empty()) h /= static_cast<float>(words.size());
-  return h;
-}
-
 void Vocabulary::Write(cv::FileStorage& fs, const std::string& name) const {
   fs << name << "{" << "words" << size() << "dims" << dims();
   fs.writeComment("word centres, one per row");

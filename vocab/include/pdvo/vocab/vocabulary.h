@@ -20,10 +20,9 @@ class Vocabulary {
   // From given word centres (rows, CV_32F).
   explicit Vocabulary(cv::Mat centres);
 
-  // The nearest word of each row (FLANN kd-tree with `checks` leaves visited; exact for small vocabularies).
-  std::vector<int> Quantise(const cv::Mat& descriptors, int checks = 16) const;
-  // Normalised histogram (sums to 1) of the words of `descriptors`; zeros if there are none.
-  cv::Mat Histogram(const cv::Mat& descriptors) const;
+  // The nearest word of each row (FLANN kd-tree with `checks` leaves visited: approximate; at 64, 98% of real
+  // gradient descriptors get their exact nearest word, see the test).
+  std::vector<int> Quantise(const cv::Mat& descriptors, int checks = 64) const;
 
   int size() const { return centres_.rows; }
   int dims() const { return centres_.cols; }
