@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdio>
+#include <exception>
 #include <iostream>
 #include <mutex>
 
@@ -58,9 +59,14 @@ Progress::Progress(std::string what, size_t total, double plain_interval_s)
       plain_interval_s_(plain_interval_s),
       tty_(isatty(STDERR_FILENO) != 0),
       start_(std::chrono::steady_clock::now()),
-      last_print_(start_) {}
+      last_print_(start_),
+      uncaught_at_start_(std::uncaught_exceptions()) {}
 
-Progress::~Progress() { Finish(); }
+Progress::~Progress() {
+  // Unwinding from an error: the loop did not finish, and its error line should stand alone.
+  if (std::uncaught_exceptions() > uncaught_at_start_) finished_ = true;
+  Finish();
+}
 
 double Progress::Rate() const {
   const double s =

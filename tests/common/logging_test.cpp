@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <stdexcept>
+
 #include "pdvo/common/errors.h"
 
 namespace pdvo {
@@ -46,6 +48,21 @@ TEST(Progress, CountsStepsAndPrintsPlainLinesWhenNotOnATerminal) {
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("work: 4/4"), std::string::npos) << err;  // the final line, printed once
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1);
+  SetLogLevel(before);
+}
+
+TEST(Progress, PrintsNoFinalLineWhenItsLoopFails) {
+  const LogLevel before = GetLogLevel();
+  SetLogLevel(LogLevel::kInfo);
+  testing::internal::CaptureStderr();
+  try {
+    Progress progress("work", 4, 1e9);
+    progress.Step();
+    throw std::runtime_error("fails");
+  } catch (const std::runtime_error&) {
+  }
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(err, "");  // the error's own line then stands alone
   SetLogLevel(before);
 }
 

@@ -62,6 +62,7 @@ class Progress {
   bool tty_;
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_, last_print_;
+  int uncaught_at_start_;  // std::uncaught_exceptions() at construction
 };
 
 }  // namespace pdvo
