@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <numeric>
+#include <optional>
 #include <random>
 
 #include "pdvo/common/errors.h"
@@ -91,6 +92,39 @@ void Split(const std::vector<int>& image_of_row, const std::vector<int>& fold_of
   for (size_t r = 0; r < image_of_row.size(); ++r) {
     (fold_of_image[image_of_row[r]] == k ? test : train)->push_back(static_cast<int>(r));
   }
+}
+
+struct WidthChoice {
+  double gamma = 0;
+  double loss = -1;  // mean cross-validated loss per test row; -1 without cross-validation
+};
+
+// The kernel width among `gammas` with the lowest mean loss over the folds (grouped by image). `fold_loss(train,
+// test, gamma)` trains on the rows `train` and returns the summed loss over the rows `test`, or nothing to skip
+// the fold. With fewer than 2 folds (or no rows), the first width.
+template <class FoldLoss>
+WidthChoice ChooseWidth(const std::vector<double>& gammas, int folds, const std::vector<int>& image_of_row,
+                        const std::vector<int>& fold_of_image, const char* what, FoldLoss fold_loss) {
+  WidthChoice best{gammas.front(), -1};
+  if (folds < 2 || image_of_row.empty()) return best;
+  for (double g : gammas) {
+    double sum = 0;
+    size_t tested = 0;
+    std::vector<int> train, test;
+    for (int f = 0; f < folds; ++f) {
+      Split(image_of_row, fold_of_image, f, &train, &test);
+      if (train.empty() || test.empty()) continue;
+      const std::optional<double> loss = fold_loss(train, test, g);
+      if (!loss) continue;
+      sum += *loss;
+      tested += test.size();
+    }
+    if (tested == 0) continue;
+    const double mean = sum / tested;
+    PDVO_LOG(Info) << "cross-validation: gamma " << g << "/D, " << what << " " << mean;
+    if (best.loss < 0 || mean < best.loss) best = {g, mean};
+  }
+  return best;
 }
 
 }  // namespace
@@ -226,34 +260,29 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
     labels.push_back(regions[k].labelled.planar ? 1.0 : -1.0);
     image_c.push_back(regions[k].image);
   }
-  double best_gamma = rvm.gammas.front(), best_accuracy = -1;
-  if (folds >= 2) {
-    for (double g : rvm.gammas) {
-      int correct = 0, tested = 0;
-      std::vector<int> train, test;
-      for (int f = 0; f < folds; ++f) {
-        Split(image_c, fold_of_image, f, &train, &test);
+  // Loss: the share of misclassified test rows.
+  const WidthChoice classifier_width =
+      ChooseWidth(rvm.gammas, folds, image_c, fold_of_image, "classifier error",
+                  [&](const auto& train, const auto& test, double g) {
         const std::vector<double> train_labels = Pick(labels, train);
-        if (test.empty() || std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
+        std::optional<double> errors;
+        if (std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
             std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
-          continue;
+          return errors;  // a fold without both classes says nothing
         }
-        const RvmFunction fn = internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g), rvm.epsilon,
-                                                            rvm.max_iterations);
-        for (int r : test) correct += (fn(xc.row(r).transpose()) >= 0) == (labels[r] > 0), ++tested;
-      }
-      const double accuracy = tested ? static_cast<double>(correct) / tested : 0;
-      PDVO_LOG(Info) << "classifier cv: gamma " << g << "/D accuracy " << accuracy;
-      if (accuracy > best_accuracy) best_accuracy = accuracy, best_gamma = g;
-    }
-  }
+        const RvmFunction fn =
+            internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g), rvm.epsilon, rvm.max_iterations);
+        errors = 0.0;
+        for (int r : test) *errors += (fn(xc.row(r).transpose()) >= 0) != (labels[r] > 0);
+        return errors;
+      });
+  const double best_gamma = classifier_width.gamma;
   PlaneModel model;
   model.classifier = internal::TrainRvmClassifier(xc, labels, gamma_of(best_gamma), rvm.epsilon, rvm.max_iterations);
   PDVO_LOG(Info) << "[time] classifier (gamma " << best_gamma << "/D, " << model.classifier.size()
                  << " relevance vectors) in " << Since(stage) << " s";
 
   stage = Clock::now();
-  double best_normal_gamma = rvm.gammas.front(), best_error = -1;
   const Eigen::MatrixXd xn = matrix_of(normals);
   std::vector<Eigen::Vector3d> targets;
   std::vector<int> image_n;
@@ -261,23 +290,17 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
     targets.push_back(*regions[k].labelled.normal);
     image_n.push_back(regions[k].image);
   }
+  // Loss: the angle between the true and the predicted normal, in degrees.
+  const WidthChoice normal_width =
+      ChooseWidth(rvm.gammas, folds, image_n, fold_of_image, "normal error (deg)",
+                  [&](const auto& train, const auto& test, double g) {
+        const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
+        std::optional<double> sum = 0.0;
+        for (int r : test) *sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose()));
+        return sum;
+      });
+  const double best_normal_gamma = normal_width.gamma;
   if (!normals.empty()) {
-    if (folds >= 2) {
-      for (double g : rvm.gammas) {
-        double sum = 0;
-        int tested = 0;
-        std::vector<int> train, test;
-        for (int f = 0; f < folds; ++f) {
-          Split(image_n, fold_of_image, f, &train, &test);
-          if (test.empty() || train.empty()) continue;
-          const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
-          for (int r : test) sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose())), ++tested;
-        }
-        const double error = tested ? sum / tested : 180;
-        PDVO_LOG(Info) << "normal cv: gamma " << g << "/D mean error " << error << " deg";
-        if (best_error < 0 || error < best_error) best_error = error, best_normal_gamma = g;
-      }
-    }
     model.normal = TrainNormal(xn, targets, gamma_of(best_normal_gamma), rvm);
   } else {
     PDVO_LOG(Warning) << "no plane regions with normals: the model predicts no orientation";
@@ -299,8 +322,8 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   model.card.non_plane_regions = static_cast<int>(per_class);
   model.card.normal_regions = static_cast<int>(normals.size());
   model.card.folds = folds;
-  model.card.cv_accuracy = std::max(0.0, best_accuracy);
-  model.card.cv_normal_error = std::max(0.0, best_error);
+  model.card.cv_accuracy = classifier_width.loss < 0 ? 0 : 1 - classifier_width.loss;
+  model.card.cv_normal_error = std::max(0.0, normal_width.loss);
   model.card.seed = static_cast<int>(seed);
   PDVO_LOG(Info) << "[time] trained in " << Since(start) << " s";
   return model;
