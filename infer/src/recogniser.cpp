@@ -1,5 +1,7 @@
 #include "pdvo/infer/recogniser.h"
 
+#include <Eigen/Cholesky>
+#include <array>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,9 +18,9 @@ ImageWords QuantiseFeatures(const Features& f, const Vocabulary& gradient_words,
   w.points = f.points;
   w.gradient = gradient_words.Quantise(f.gradient);
   w.colour = colour_words.Quantise(f.colour);
-  for (float theta : f.orientation) {
-    w.orientation.push_back(std::min(kOrientationBins - 1, static_cast<int>(theta / CV_PI * kOrientationBins)));
-  }
+  w.angle = f.orientation;
+  w.coherence = f.coherence;
+  w.image_size = f.image_size;
   return w;
 }
 
@@ -40,6 +42,7 @@ RegionWords CollectRegionWords(const ImageWords& words, const Region& region, in
                                int colour_words) {
   RegionWords r;
   r.box = cv::Rect2d(region.box.x - 0.5, region.box.y - 0.5, region.box.width, region.box.height);
+  r.image_size = words.image_size;
   r.histogram = Eigen::VectorXd::Zero(gradient_words + colour_words);
   for (size_t i = 0; i < words.size(); ++i) {
     if (!region.Contains(words.points[i])) continue;
@@ -49,12 +52,50 @@ RegionWords CollectRegionWords(const ImageWords& words, const Region& region, in
     r.points.push_back(words.points[i]);
     r.gradient.push_back(g);
     r.colour.push_back(gradient_words + c);
-    r.orientation.push_back(words.orientation[i]);
+    r.orientation.push_back(
+        std::min(kOrientationBins - 1, static_cast<int>(words.angle[i] / CV_PI * kOrientationBins)));
+    r.angle.push_back(words.angle[i]);
+    r.coherence.push_back(words.coherence[i]);
     r.histogram[g] += 1;
     r.histogram[gradient_words + c] += 1;
   }
   if (r.size() > 0) r.histogram /= 2.0 * r.size();
   return r;
+}
+
+Eigen::VectorXd LayoutFeature(const RegionWords& r) {
+  PDVO_THROW_CHECK(r.image_size.width > 0 && r.image_size.height > 0, InvalidArgument, "layout: no image size");
+  const double w = r.image_size.width;
+  const Eigen::Vector2d image_centre(r.image_size.width / 2.0, r.image_size.height / 2.0);
+  const Eigen::Vector2d centre(r.box.x + r.box.width / 2, r.box.y + r.box.height / 2);
+  // Per family, weighted least squares of the edge angle on (1, dx, dy), dx and dy from the region's centre in
+  // image widths; a small ridge keeps the slopes of a thin or tiny region finite.
+  constexpr double kRidge = 1e-4;
+  std::array<Eigen::Matrix3d, 2> normal_matrix = {kRidge * Eigen::Matrix3d::Identity(),
+                                                  kRidge * Eigen::Matrix3d::Identity()};
+  normal_matrix[0](0, 0) = normal_matrix[1](0, 0) = 0;
+  std::array<Eigen::Vector3d, 2> moment = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<double, 2> mass = {0, 0};
+  for (int i = 0; i < r.size(); ++i) {
+    // The edge runs across the gradient: its angle, folded into (-pi/4, pi/4] about its family's axis.
+    const double gradient = r.angle[i];
+    const int family = gradient > CV_PI / 4 && gradient <= 3 * CV_PI / 4 ? 0 : 1;  // 0: near horizontal edges
+    double edge = family == 0 ? gradient - CV_PI / 2 : gradient;
+    if (edge > CV_PI / 2) edge -= CV_PI;
+    const Eigen::Vector3d a(1, (r.points[i].x - centre.x()) / w, (r.points[i].y - centre.y()) / w);
+    const double weight = static_cast<double>(r.coherence[i]) * r.coherence[i];
+    normal_matrix[family] += weight * a * a.transpose();
+    moment[family] += weight * edge * a;
+    mass[family] += weight;
+  }
+  Eigen::VectorXd out(kLayoutDims);
+  out.head<4>() << (centre - image_centre) / w, r.box.width / w, r.box.height / w;
+  for (int f = 0; f < 2; ++f) {
+    out.segment<3>(4 + 3 * f) =
+        mass[f] > 0 ? Eigen::Vector3d(normal_matrix[f].ldlt().solve(moment[f])) : Eigen::Vector3d::Zero();
+  }
+  out[10] = mass[0] + mass[1] > 0 ? mass[0] / (mass[0] + mass[1]) : 0.5;
+  return out;
 }
 
 Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& topics, int topic_iterations) {
@@ -72,8 +113,9 @@ Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& 
       ComputeSpatiogram(Eigen::MatrixXd::Identity(kOrientationBins, kOrientationBins), region.orientation,
                         region.points, region.box, shares)
           .ToVector();
-  Eigen::VectorXd feature(by_topic.size() + by_orientation.size());
-  feature << by_topic, by_orientation;
+  const Eigen::VectorXd layout = LayoutFeature(region);
+  Eigen::VectorXd feature(by_topic.size() + by_orientation.size() + layout.size());
+  feature << by_topic, by_orientation, layout;
   return feature;
 }
 
@@ -94,7 +136,7 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
 Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
   PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(),
                    InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
-  const Eigen::Index dims = 6 * (model_.topics.cols() + kOrientationBins);
+  const Eigen::Index dims = RegionFeatureDims(static_cast<int>(model_.topics.cols()));
   const bool classifier_fits = model_.classifier.size() == 0 || model_.classifier.vectors.cols() == dims;
   PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifier_fits, InvalidArgument,
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);

@@ -33,7 +33,7 @@ PlaneModel RandomModel() {
   m.gradient_words = Vocabulary(g);
   m.colour_words = Vocabulary(c);
   m.topics = Eigen::MatrixXd::NullaryExpr(17, 3, [&]() { return u(rng); });
-  const int dims = 6 * 3 + 6 * kOrientationBins;
+  const int dims = RegionFeatureDims(3);
   m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
   m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
   m.classifier = RandomRvm(4, dims, rng);

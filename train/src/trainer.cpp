@@ -142,6 +142,7 @@ bool TrainOptions::Check() const {
   PDVO_CHECK_OPTION(vocabulary_samples >= std::max(gradient_words, colour_words));
   PDVO_CHECK_OPTION(kmeans_iterations >= 1);
   PDVO_CHECK_OPTION(max_regions_per_class >= 2 && max_normal_regions >= 0);
+  PDVO_CHECK_OPTION(layout_weight > 0);
   return true;
 }
 
@@ -239,7 +240,8 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (int k : used) mean += raw[k];
   mean /= used.size();
   for (int k : used) var += (raw[k] - mean).cwiseAbs2();
-  const Eigen::VectorXd scale = (var / used.size()).cwiseSqrt().cwiseMax(1e-6);
+  Eigen::VectorXd scale = (var / used.size()).cwiseSqrt().cwiseMax(1e-6);
+  scale.tail(kLayoutDims) /= o.layout_weight;
   auto matrix_of = [&](const std::vector<int>& rows) {
     Eigen::MatrixXd x(rows.size(), dims);
     for (size_t i = 0; i < rows.size(); ++i) x.row(i) = (raw[rows[i]] - mean).cwiseQuotient(scale).transpose();

@@ -1,6 +1,7 @@
 #include "pdvo/vocab/features.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -120,6 +121,7 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
   if (static_cast<int>(kept.size()) > o.max_points) kept.resize(o.max_points);
 
   Features f;
+  f.image_size = image.size();
   f.gradient.create(static_cast<int>(kept.size()), kGradientDims, CV_32F);
   f.colour.create(static_cast<int>(kept.size()), kColourDims, CV_32F);
   if (kept.empty()) return f;
@@ -149,6 +151,8 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
     double theta = 0.5 * std::atan2(2 * t[2], t[0] - t[1]);  // (-pi/2, pi/2]
     if (theta < 0) theta += CV_PI;
     f.orientation.push_back(static_cast<float>(std::min(theta, CV_PI - 1e-9)));
+    const double energy = t[0] + t[1];
+    f.coherence.push_back(energy > 0 ? static_cast<float>(std::hypot(t[0] - t[1], 2 * t[2]) / energy) : 0.0f);
   }
   return f;
 }

@@ -15,12 +15,14 @@ namespace pdvo {
 // Line orientations are quantised into this many bins over [0, pi).
 inline constexpr int kOrientationBins = 8;
 
-// An image's salient points and each point's gradient word, colour word and orientation bin.
+// An image's salient points and each point's gradient word, colour word and dominant gradient direction.
 struct ImageWords {
   std::vector<cv::Point2f> points;
   std::vector<int> gradient;
   std::vector<int> colour;
-  std::vector<int> orientation;
+  std::vector<float> angle;      // radians in [0, pi), see Features::orientation
+  std::vector<float> coherence;  // in [0, 1]
+  cv::Size image_size;
   size_t size() const { return points.size(); }
 };
 
@@ -30,24 +32,40 @@ ImageWords QuantiseFeatures(const Features& features, const Vocabulary& gradient
 // `image` resized to `working_width` (unchanged if 0 or already that wide); `scale` gets new / old width.
 cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale = nullptr);
 
-// The points of a region with their words (colour words offset past the gradient words) and orientation bins,
-// and the normalised histogram of all their words.
+// The points of a region with their words (colour words offset past the gradient words), orientation bins and
+// gradient directions, and the normalised histogram of all their words.
 struct RegionWords {
   std::vector<cv::Point2f> points;
   std::vector<int> gradient;     // per point, in [0, gradient words)
   std::vector<int> colour;       // per point, in [gradient words, gradient + colour words)
   std::vector<int> orientation;  // per point, in [0, kOrientationBins)
+  std::vector<float> angle;      // per point, as in ImageWords
+  std::vector<float> coherence;
   cv::Rect2d box;                // the region's extent in pixel-edge coordinates
+  cv::Size image_size;
   Eigen::VectorXd histogram;     // gradient words + colour words, sums to 1 (zero if no points)
   int size() const { return static_cast<int>(points.size()); }
 };
 RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words, int colour_words);
 
+// The region's layout: where it lies in the image and how its edges' directions vary across it, the
+// perspective cue to a plane's orientation (edges of one 3D direction converge towards their vanishing point).
+// Each point's edge (across its gradient direction) joins one of two families, near horizontal or near
+// vertical, and gets its angle from its family's axis in (-pi/4, pi/4]. Per family, a weighted (coherence
+// squared) least-squares plane angle = a + b dx + c dy over the points, dx, dy from the region's centre.
+// Lengths are in image widths. Values: the centre from the image centre (2), width and height (2), (a, b, c)
+// of the near-horizontal edges and of the near-vertical ones (3 + 3, zero without such edges), and the near-
+// horizontal family's share of the weight (1).
+inline constexpr int kLayoutDims = 11;
+Eigen::VectorXd LayoutFeature(const RegionWords& region);
+
 // The feature vector of a region (not standardised): the spatiogram of its topics (6 values per topic), then
 // the spatiogram of its points' dominant gradient orientations (6 values per orientation bin): where in the
-// region each edge direction lies, the perspective cue to the orientation of a textured plane.
+// region each edge direction lies, the perspective cue to the orientation of a textured plane; then its layout.
 // `topics` has the gradient words' rows first, then the colour words'.
 Eigen::VectorXd RegionFeature(const RegionWords& region, const Eigen::MatrixXd& topics, int topic_iterations);
+// Its size for `topics` topics.
+inline int RegionFeatureDims(int topics) { return 6 * (topics + kOrientationBins) + kLayoutDims; }
 
 // An annotation and its image at a working width (the annotation itself stays at full resolution).
 struct AnnotatedImage {

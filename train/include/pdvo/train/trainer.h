@@ -41,6 +41,9 @@ struct TrainOptions {
   // Training cost grows with the cube of the sample count: regions are drawn at random up to these bounds.
   int max_regions_per_class = 600;  // classes are balanced to the smaller class, at most this many each
   int max_normal_regions = 400;     // planes with normals for the regressors
+  // The layout values (see LayoutFeature) count this much more than the others in the kernel's distance: a few
+  // values among ~170 would otherwise hardly move it.
+  double layout_weight = 1;
   RvmOptions rvm;
 
   template <class Self, class V>
@@ -54,6 +57,7 @@ struct TrainOptions {
     visit("topics", self.topics);
     visit("max_regions_per_class", self.max_regions_per_class);
     visit("max_normal_regions", self.max_normal_regions);
+    visit("layout_weight", self.layout_weight);
     visit("rvm", self.rvm);
   }
   bool Check() const;

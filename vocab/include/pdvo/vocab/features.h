@@ -37,6 +37,8 @@ struct Features {
   cv::Mat gradient;                 // N x 128, CV_32F
   cv::Mat colour;                   // N x 12, CV_32F
   std::vector<float> orientation;   // radians in [0, pi): the patch's dominant gradient direction (structure tensor)
+  std::vector<float> coherence;     // in [0, 1]: how much of the patch's gradient energy lies along that direction
+  cv::Size image_size;              // of the described image
   size_t size() const { return points.size(); }
 };
 
