@@ -18,10 +18,19 @@ cv::Mat ToMat(const Eigen::MatrixXd& m) {
   return out;
 }
 
+// Single precision: the relevance vectors are most of a model's bytes.
+cv::Mat ToFloatMat(const Eigen::MatrixXd& m) {
+  cv::Mat out;
+  ToMat(m).convertTo(out, CV_32F);
+  return out;
+}
+
 Eigen::MatrixXd ReadMatrix(const cv::FileNode& node, const std::string& where, const std::string& key) {
   cv::Mat m;
   node[key] >> m;
-  PDVO_THROW_CHECK(!m.empty() && m.type() == CV_64F, FormatError, where << ": missing or malformed '" << key << "'");
+  PDVO_THROW_CHECK(!m.empty() && (m.type() == CV_64F || m.type() == CV_32F), FormatError,
+                   where << ": missing or malformed '" << key << "'");
+  m.convertTo(m, CV_64F);
   Eigen::MatrixXd out;
   cv::cv2eigen(m, out);
   PDVO_THROW_CHECK(out.allFinite(), FormatError, where << ": '" << key << "' holds NaN or infinite values");
@@ -30,7 +39,7 @@ Eigen::MatrixXd ReadMatrix(const cv::FileNode& node, const std::string& where, c
 
 void WriteRvm(cv::FileStorage& fs, const std::string& name, const RvmFunction& f) {
   fs << name << "{" << "gamma" << f.gamma << "bias" << f.bias << "relevance_vectors" << f.size();
-  fs << "weights" << ToMat(f.weights) << "vectors" << ToMat(f.vectors) << "}";
+  fs << "weights" << ToMat(f.weights) << "vectors" << ToFloatMat(f.vectors) << "}";
 }
 
 RvmFunction ReadRvm(const cv::FileNode& node, const std::string& where, int dims) {

@@ -1,7 +1,8 @@
 // The plane recogniser's model: everything inference needs, in ONE versioned file (cv::FileStorage YAML):
 // the recogniser options, the two vocabularies, the topic basis, the feature standardisation, the RVM
 // classifier (plane probability) and three RVM regressors (normal components), and a training card.
-// Writing is atomic; re-writing a read model gives the same bytes.
+// Writing is atomic; re-writing a read model gives the same bytes. Relevance vectors are stored in single
+// precision (most of the file's bytes; predictions move by about 1e-7 relative), everything else in double.
 #pragma once
 
 #include <Eigen/Core>

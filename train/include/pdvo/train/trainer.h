@@ -16,7 +16,7 @@ namespace pdvo {
 
 struct RvmOptions {
   // RBF kernel widths tried, gamma = value / feature dimensions (features are standardised).
-  std::vector<double> gammas = {0.5, 1.5};
+  std::vector<double> gammas = {0.2, 0.5};
   double epsilon = 1e-3;      // dlib's stopping tolerance (classifier)
   int max_iterations = 400;   // classifier iterations; normal regressors: steps (bounds their relevance vectors)
 
@@ -43,7 +43,7 @@ struct TrainOptions {
   int max_normal_regions = 400;     // planes with normals for the regressors
   // The layout values (see LayoutFeature) count this much more than the others in the kernel's distance: a few
   // values among ~170 would otherwise hardly move it.
-  double layout_weight = 1;
+  double layout_weight = 6;
   RvmOptions rvm;
 
   template <class Self, class V>
