@@ -1,0 +1,77 @@
+// Patch warping and NCC on generated images: a pure shift gives the reference's pixels exactly, a general
+// homography agrees with OpenCV's warpPerspective, and NCC is invariant to gain and offset.
+#include "pdvo/vo/patch.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/common/errors.h"
+
+namespace pdvo::vo {
+namespace {
+
+cv::Mat Texture() {
+  cv::Mat noise(240, 320, CV_8U), smooth;
+  cv::RNG rng(7);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(noise, smooth, cv::Size(0, 0), 1.5);
+  cv::normalize(smooth, smooth, 0, 255, cv::NORM_MINMAX);
+  return smooth;
+}
+
+TEST(Patch, IntegerShiftCopiesTheReference) {
+  const cv::Mat image = Texture();
+  Eigen::Matrix3d h = Eigen::Matrix3d::Identity();
+  h(0, 2) = 3;
+  h(1, 2) = -2;
+  cv::Mat patch;
+  ASSERT_TRUE(WarpPatch(image, h, Eigen::Vector2d(103, 48), 5, &patch));
+  ASSERT_EQ(patch.size(), cv::Size(11, 11));
+  cv::Mat expected;
+  image(cv::Rect(100 - 5, 50 - 5, 11, 11)).convertTo(expected, CV_32F);
+  EXPECT_EQ(cv::norm(patch, expected, cv::NORM_INF), 0);
+}
+
+TEST(Patch, AgreesWithWarpPerspective) {
+  const cv::Mat image = Texture();
+  Eigen::Matrix3d h;
+  h << 0.9, 0.15, 12, -0.1, 1.05, 4, 2e-4, -1e-4, 1;
+  cv::Mat h_cv(3, 3, CV_64F), warped;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) h_cv.at<double>(r, c) = h(r, c);
+  cv::warpPerspective(image, warped, h_cv, image.size(), cv::INTER_LINEAR);
+  cv::Mat patch, expected;
+  ASSERT_TRUE(WarpPatch(image, h, Eigen::Vector2d(150, 110), 7, &patch));
+  warped(cv::Rect(150 - 7, 110 - 7, 15, 15)).convertTo(expected, CV_32F);
+  // OpenCV interpolates in fixed point (1/32 px, 8-bit result): within a grey level or so.
+  EXPECT_LT(cv::norm(patch, expected, cv::NORM_INF), 2.0);
+  EXPECT_GT(Ncc(patch, expected), 0.999);
+}
+
+TEST(Patch, OutsideOrSingularGivesNoPatch) {
+  const cv::Mat image = Texture();
+  cv::Mat patch(1, 1, CV_32F, cv::Scalar(42));
+  EXPECT_FALSE(WarpPatch(image, Eigen::Matrix3d::Identity(), Eigen::Vector2d(3, 100), 5, &patch));
+  EXPECT_FALSE(WarpPatch(image, Eigen::Matrix3d::Zero(), Eigen::Vector2d(100, 100), 5, &patch));
+  EXPECT_EQ(patch.at<float>(0, 0), 42);  // untouched
+  EXPECT_THROW(WarpPatch(cv::Mat(10, 10, CV_8UC3), Eigen::Matrix3d::Identity(), Eigen::Vector2d(5, 5), 1, &patch),
+               InvalidArgument);
+}
+
+TEST(Patch, NccIsInvariantToGainAndOffset) {
+  const cv::Mat image = Texture();
+  const cv::Mat a = image(cv::Rect(40, 40, 9, 9));
+  cv::Mat brighter, negative;
+  a.convertTo(brighter, CV_32F, 0.5, 30);
+  a.convertTo(negative, CV_32F, -1, 255);
+  EXPECT_NEAR(Ncc(a, a), 1, 1e-12);
+  EXPECT_NEAR(Ncc(a, brighter), 1, 1e-6);
+  EXPECT_NEAR(Ncc(a, negative), -1, 1e-6);
+  EXPECT_LT(std::abs(Ncc(a, image(cv::Rect(200, 150, 9, 9)))), 0.9);  // elsewhere in the texture
+  EXPECT_EQ(Ncc(a, cv::Mat(9, 9, CV_8U, cv::Scalar(5))), 0);            // flat
+  EXPECT_THROW(Ncc(a, image(cv::Rect(0, 0, 5, 5))), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo::vo

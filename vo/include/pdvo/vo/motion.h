@@ -1,0 +1,45 @@
+// The camera of the EKF (the paper's section IV, after Davison's MonoSLAM): position and orientation in the
+// world, linear velocity (world frame) and angular velocity (camera frame), under a constant-velocity model
+// driven by random accelerations. The filter works on a 12-D error state
+//   (dp, dtheta, dv, dw):  p + dp,  q * Exp(dtheta) (rotation perturbed on the right, in the camera frame),
+//                          v + dv,  w + dw.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "pdvo/common/geometry.h"
+
+namespace pdvo::vo {
+
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+
+struct CameraState {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();                  // camera centre in the world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();     // world_from_cam rotation
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();                  // world frame, per second
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();          // camera frame, rad per second
+
+  Rigid3d world_from_cam() const { return Rigid3d(orientation, position); }
+  // The state moved by an error-state step, and the step from `other` to this (inverse of Plus).
+  CameraState Plus(const Vector12d& delta) const;
+  Vector12d Minus(const CameraState& other) const;
+};
+
+// Constant velocity over dt seconds, the velocities taking random impulses V = a dt and W = alpha dt first:
+//   p' = p + (v + V) dt,  q' = q Exp((w + W) dt),  v' = v + V,  w' = w + W.
+// With `f` and `g`, the Jacobians of the error state after the step with respect to the error state before it
+// (12x12) and to the impulses (V, W) (12x6), at zero impulse.
+CameraState PredictCamera(const CameraState& state, double dt, Matrix12d* f = nullptr,
+                          Eigen::Matrix<double, 12, 6>* g = nullptr);
+
+// The process noise of a step: g diag(sigma_a^2 dt^2 I, sigma_alpha^2 dt^2 I) g^T, with accelerations in
+// m/s^2 and rad/s^2 (standard deviations).
+Matrix12d ProcessNoise(const Eigen::Matrix<double, 12, 6>& g, double dt, double linear_acceleration,
+                       double angular_acceleration);
+
+// The right Jacobian of SO(3): Exp(phi + d) ~ Exp(phi) Exp(Jr(phi) d).
+Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& phi);
+
+}  // namespace pdvo::vo

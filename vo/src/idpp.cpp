@@ -1,0 +1,73 @@
+#include "pdvo/vo/idpp.h"
+
+namespace pdvo::vo {
+
+Eigen::Matrix3d Pinhole::K() const {
+  Eigen::Matrix3d k;
+  k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+  return k;
+}
+
+Eigen::Vector2d Pinhole::Project(const Eigen::Vector3d& p) const {
+  return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+}
+
+Eigen::Vector3d Pinhole::Ray(const Eigen::Vector2d& pixel) const {
+  return Eigen::Vector3d((pixel.x() - cx) / fx, (pixel.y() - cy) / fy, 1).normalized();
+}
+
+double InversePlane::InverseDepthAlong(const Eigen::Vector3d& ray) const {
+  return -inverse_distance * normal.normalized().dot(ray);
+}
+
+bool ProjectInverseDepth(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+                         const Eigen::Vector3d& ray, double rho, Eigen::Vector2d* pixel, ProjectionJacobians* j) {
+  const Eigen::Matrix3d rc_t = world_from_current.rotation.toRotationMatrix().transpose();
+  const Eigen::Matrix3d rr = world_from_ref.rotation.toRotationMatrix();
+  const Eigen::Vector3d baseline = world_from_ref.translation - world_from_current.translation;
+  const Eigen::Vector3d h = rc_t * (rho * baseline + rr * ray);
+  if (h.z() <= 1e-9 * h.norm()) return false;
+  *pixel = camera.Project(h);
+  if (!j) return true;
+  Matrix23d dpixel_dh;
+  dpixel_dh << camera.fx / h.z(), 0, -camera.fx * h.x() / (h.z() * h.z()), 0, camera.fy / h.z(),
+      -camera.fy * h.y() / (h.z() * h.z());
+  j->current << dpixel_dh * (-rho * rc_t), dpixel_dh * Hat(h);
+  j->reference << dpixel_dh * (rho * rc_t), dpixel_dh * (-rc_t * rr * Hat(ray));
+  j->inverse_depth = dpixel_dh * (rc_t * baseline);
+  return true;
+}
+
+bool ProjectPlanePoint(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+                       const InversePlane& plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
+                       ProjectionJacobians* j, Eigen::Matrix<double, 2, 4>* plane_jacobian) {
+  const double rho = plane.InverseDepthAlong(ray);
+  if (rho <= 0) return false;
+  if (!ProjectInverseDepth(camera, world_from_current, world_from_ref, ray, rho, pixel, j)) return false;
+  if (plane_jacobian && j) {
+    // rho = -rho_p (n^ . m), n^ = n / |n|: d n^ / d n = (I - n^ n^T) / |n|.
+    const double norm = plane.normal.norm();
+    const Eigen::Vector3d unit = plane.normal / norm;
+    const Eigen::RowVector3d drho_dn =
+        -plane.inverse_distance * ray.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm;
+    plane_jacobian->leftCols<3>() = j->inverse_depth * drho_dn;
+    plane_jacobian->col(3) = j->inverse_depth * (-unit.dot(ray));
+  }
+  return true;
+}
+
+Eigen::Matrix3d PlaneHomography(const Pinhole& camera, const Rigid3d& world_from_current,
+                                const Rigid3d& world_from_ref, const InversePlane& plane) {
+  const Rigid3d current_from_ref = world_from_current.Inverse() * world_from_ref;
+  const Eigen::Matrix3d k = camera.K();
+  const Eigen::Matrix3d euclidean = current_from_ref.rotation.toRotationMatrix() -
+                                    plane.inverse_distance * current_from_ref.translation *
+                                        plane.normal.normalized().transpose();
+  return k * euclidean * k.inverse();
+}
+
+InversePlane FrontoParallel(const Eigen::Vector3d& ray, double inverse_depth) {
+  return {-ray.normalized(), inverse_depth};
+}
+
+}  // namespace pdvo::vo

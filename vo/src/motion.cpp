@@ -1,0 +1,55 @@
+#include "pdvo/vo/motion.h"
+
+namespace pdvo::vo {
+
+CameraState CameraState::Plus(const Vector12d& d) const {
+  CameraState s;
+  s.position = position + d.segment<3>(0);
+  s.orientation = (orientation * ExpSO3(d.segment<3>(3))).normalized();
+  s.velocity = velocity + d.segment<3>(6);
+  s.angular_velocity = angular_velocity + d.segment<3>(9);
+  return s;
+}
+
+Vector12d CameraState::Minus(const CameraState& other) const {
+  Vector12d d;
+  d << position - other.position, LogSO3(other.orientation.conjugate() * orientation), velocity - other.velocity,
+      angular_velocity - other.angular_velocity;
+  return d;
+}
+
+Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& phi) { return LeftJacobianSO3(-phi); }
+
+CameraState PredictCamera(const CameraState& s, double dt, Matrix12d* f, Eigen::Matrix<double, 12, 6>* g) {
+  const Eigen::Vector3d turn = s.angular_velocity * dt;
+  CameraState out = s;
+  out.position = s.position + s.velocity * dt;
+  out.orientation = (s.orientation * ExpSO3(turn)).normalized();
+  const Eigen::Matrix3d step_rotation = ExpSO3(turn).toRotationMatrix();
+  const Eigen::Matrix3d jr = RightJacobianSO3(turn);
+  const Eigen::Matrix3d eye = Eigen::Matrix3d::Identity();
+  if (f) {
+    f->setIdentity();
+    f->block<3, 3>(0, 6) = dt * eye;                       // position from velocity
+    f->block<3, 3>(3, 3) = step_rotation.transpose();      // an orientation error seen from the new orientation
+    f->block<3, 3>(3, 9) = dt * jr;                        // orientation from angular velocity
+  }
+  if (g) {
+    g->setZero();
+    g->block<3, 3>(0, 0) = dt * eye;
+    g->block<3, 3>(3, 3) = dt * jr;
+    g->block<3, 3>(6, 0) = eye;
+    g->block<3, 3>(9, 3) = eye;
+  }
+  return out;
+}
+
+Matrix12d ProcessNoise(const Eigen::Matrix<double, 12, 6>& g, double dt, double linear_acceleration,
+                       double angular_acceleration) {
+  Eigen::Matrix<double, 6, 1> variances;
+  variances << Eigen::Vector3d::Constant(linear_acceleration * linear_acceleration * dt * dt),
+      Eigen::Vector3d::Constant(angular_acceleration * angular_acceleration * dt * dt);
+  return g * variances.asDiagonal() * g.transpose();
+}
+
+}  // namespace pdvo::vo
