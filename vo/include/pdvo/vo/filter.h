@@ -1,0 +1,83 @@
+// The EKF's state and its operations (the paper's section IV): the camera (motion.h), reference cameras (the
+// poses of keyframes at which features were initialised, shared by those features) and inverse-depth points
+// anchored at them (idpp.h), with one dense covariance over the error state
+//   [camera 12 | per reference camera 6 (dp, dtheta) | per point 1 (rho)]   in the order they were added.
+// Features and reference cameras are named by ids that stay valid while the rest of the state changes.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <vector>
+
+#include "pdvo/vo/idpp.h"
+#include "pdvo/vo/motion.h"
+
+namespace pdvo::vo {
+
+struct MotionNoise {
+  double linear_acceleration = 2.0;   // m/s^2, standard deviation
+  double angular_acceleration = 2.0;  // rad/s^2
+};
+
+// One pixel measurement of a point: where it was found and its noise.
+struct PointMeasurement {
+  int point = -1;              // point id
+  Eigen::Vector2d pixel;       // measured, current camera (pinhole, undistorted)
+  double sigma = 1.0;          // pixels
+};
+
+class Filter {
+ public:
+  struct Reference {
+    Rigid3d world_from_cam;
+    int offset = 0;  // in the error state
+    int users = 0;   // points anchored here
+  };
+  struct Point {
+    int reference = -1;
+    Eigen::Vector3d ray;  // unit, reference camera frame
+    double inverse_depth = 0;
+    int offset = 0;
+  };
+
+  Filter(const CameraState& camera, const Matrix12d& covariance);
+
+  const CameraState& camera() const { return camera_; }
+  const Eigen::MatrixXd& covariance() const { return covariance_; }
+  int size() const { return static_cast<int>(covariance_.rows()); }
+  const std::map<int, Reference>& references() const { return references_; }
+  const std::map<int, Point>& points() const { return points_; }
+
+  // Constant velocity over dt seconds (PredictCamera), with its process noise.
+  void Predict(double dt, const MotionNoise& noise);
+
+  // A reference camera at the current camera's pose (its covariance and correlations are the camera pose's).
+  int AddReference();
+  // A point on the ray (unit, reference frame) at inverse depth rho with standard deviation sigma_rho,
+  // uncorrelated with the rest of the state.
+  int AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho);
+  // Removes a point; a reference camera goes when its last point does.
+  void RemovePoint(int point);
+
+  // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
+  // if the point is behind the camera.
+  bool PredictPoint(const Pinhole& camera, int point, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const;
+
+  // One batched EKF update with the measurements (points must exist and be in front of the camera); returns
+  // the normalised innovation squared of the batch (chi-square with 2 x count degrees of freedom).
+  double Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements);
+
+  // Adds `delta` (size()) to the state: the camera and reference cameras on their manifolds.
+  void Apply(const Eigen::VectorXd& delta);
+
+ private:
+  void Renumber();
+
+  CameraState camera_;
+  Eigen::MatrixXd covariance_;
+  std::map<int, Reference> references_;
+  std::map<int, Point> points_;
+  int next_id_ = 0;
+};
+
+}  // namespace pdvo::vo

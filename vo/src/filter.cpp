@@ -1,0 +1,146 @@
+#include "pdvo/vo/filter.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "pdvo/common/errors.h"
+
+namespace pdvo::vo {
+
+Filter::Filter(const CameraState& camera, const Matrix12d& covariance) : camera_(camera), covariance_(covariance) {}
+
+void Filter::Predict(double dt, const MotionNoise& noise) {
+  PDVO_THROW_CHECK(dt >= 0, InvalidArgument, "filter: time went backwards (dt " << dt << " s)");
+  Matrix12d f;
+  Eigen::Matrix<double, 12, 6> g;
+  camera_ = PredictCamera(camera_, dt, &f, &g);
+  const int n = size();
+  covariance_.topLeftCorner<12, 12>() =
+      f * covariance_.topLeftCorner<12, 12>() * f.transpose() +
+      ProcessNoise(g, dt, noise.linear_acceleration, noise.angular_acceleration);
+  if (n > 12) {
+    covariance_.topRightCorner(12, n - 12) = f * covariance_.topRightCorner(12, n - 12);
+    covariance_.bottomLeftCorner(n - 12, 12) = covariance_.topRightCorner(12, n - 12).transpose();
+  }
+}
+
+int Filter::AddReference() {
+  const int n = size();
+  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(n + 6, n + 6);
+  p.topLeftCorner(n, n) = covariance_;
+  p.bottomRows(6).leftCols(n) = covariance_.topRows(6);  // the camera pose's rows: (dp, dtheta)
+  p.rightCols(6).topRows(n) = covariance_.leftCols(6);
+  p.bottomRightCorner(6, 6) = covariance_.topLeftCorner(6, 6);
+  covariance_ = std::move(p);
+  const int id = next_id_++;
+  references_[id] = {camera_.world_from_cam(), n, 0};
+  return id;
+}
+
+int Filter::AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho) {
+  auto r = references_.find(reference);
+  PDVO_THROW_CHECK(r != references_.end(), InvalidArgument, "filter: no reference camera " << reference);
+  PDVO_THROW_CHECK(sigma_rho > 0 && std::isfinite(rho), InvalidArgument, "filter: bad inverse depth prior");
+  const int n = size();
+  covariance_.conservativeResize(n + 1, n + 1);
+  covariance_.row(n).setZero();
+  covariance_.col(n).setZero();
+  covariance_(n, n) = sigma_rho * sigma_rho;
+  ++r->second.users;
+  const int id = next_id_++;
+  points_[id] = {reference, ray.normalized(), rho, n};
+  return id;
+}
+
+void Filter::RemovePoint(int id) {
+  auto p = points_.find(id);
+  PDVO_THROW_CHECK(p != points_.end(), InvalidArgument, "filter: no point " << id);
+  std::vector<int> dropped = {p->second.offset};
+  auto r = references_.find(p->second.reference);
+  if (--r->second.users == 0) {
+    for (int k = 0; k < 6; ++k) dropped.push_back(r->second.offset + k);
+    references_.erase(r);
+  }
+  points_.erase(p);
+  std::vector<int> keep;
+  for (int i = 0; i < size(); ++i) {
+    if (std::find(dropped.begin(), dropped.end(), i) == dropped.end()) keep.push_back(i);
+  }
+  covariance_ = Eigen::MatrixXd(covariance_(keep, keep));
+  Renumber();
+}
+
+void Filter::Renumber() {
+  // Removal keeps the order of what stays: new offsets are the running sum of the block sizes in that order.
+  struct Block {
+    int old_offset;
+    int* offset;
+    int size;
+  };
+  std::vector<Block> blocks;
+  for (auto& [id, r] : references_) blocks.push_back({r.offset, &r.offset, 6});
+  for (auto& [id, p] : points_) blocks.push_back({p.offset, &p.offset, 1});
+  std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.old_offset < b.old_offset; });
+  int next = 12;
+  for (Block& b : blocks) {
+    *b.offset = next;
+    next += b.size;
+  }
+}
+
+bool Filter::PredictPoint(const Pinhole& camera, int id, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
+  const Point& p = points_.at(id);
+  const Reference& r = references_.at(p.reference);
+  ProjectionJacobians j;
+  if (!ProjectInverseDepth(camera, camera_.world_from_cam(), r.world_from_cam, p.ray, p.inverse_depth, pixel,
+                           jacobian ? &j : nullptr)) {
+    return false;
+  }
+  if (jacobian) {
+    jacobian->setZero(2, size());
+    jacobian->leftCols<6>() = j.current;
+    jacobian->middleCols<6>(r.offset) = j.reference;
+    jacobian->col(p.offset) = j.inverse_depth;
+  }
+  return true;
+}
+
+double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements) {
+  if (measurements.empty()) return 0;
+  const int m = 2 * static_cast<int>(measurements.size()), n = size();
+  Eigen::MatrixXd h(m, n);
+  Eigen::VectorXd innovation(m), noise(m);
+  for (size_t k = 0; k < measurements.size(); ++k) {
+    Eigen::Vector2d predicted;
+    Eigen::MatrixXd jk;
+    PDVO_THROW_CHECK(PredictPoint(camera, measurements[k].point, &predicted, &jk), InvalidArgument,
+                     "filter: point " << measurements[k].point << " is behind the camera");
+    h.middleRows<2>(2 * k) = jk;
+    innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
+    noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
+  }
+  const Eigen::MatrixXd ph_t = covariance_ * h.transpose();
+  Eigen::MatrixXd s = h * ph_t;
+  s.diagonal() += noise;
+  const Eigen::LLT<Eigen::MatrixXd> llt(s);
+  PDVO_THROW_CHECK(llt.info() == Eigen::Success, InvalidArgument, "filter: innovation covariance not positive");
+  const Eigen::MatrixXd gain_t = llt.solve(ph_t.transpose());  // K^T = S^-1 H P
+  const double nis = innovation.dot(llt.solve(innovation));
+  Apply(gain_t.transpose() * innovation);
+  covariance_ -= ph_t * gain_t;  // P - K H P
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+  return nis;
+}
+
+void Filter::Apply(const Eigen::VectorXd& delta) {
+  PDVO_THROW_CHECK(delta.size() == size() && delta.allFinite(), InvalidArgument, "filter: bad state step");
+  camera_ = camera_.Plus(delta.head<12>());
+  for (auto& [id, r] : references_) {
+    r.world_from_cam = Rigid3d(r.world_from_cam.rotation * ExpSO3(delta.segment<3>(r.offset + 3)),
+                               r.world_from_cam.translation + delta.segment<3>(r.offset));
+  }
+  for (auto& [id, p] : points_) p.inverse_depth += delta[p.offset];
+}
+
+}  // namespace pdvo::vo
