@@ -56,5 +56,6 @@ int RunAte(int argc, char** argv);
 int RunSynth(int argc, char** argv);
 int RunTrain(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
+int RunVo(int argc, char** argv);
 
 }  // namespace pdvo::apps

@@ -108,6 +108,7 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
 
 StagedOutputDir::StagedOutputDir(const std::string& final_dir) : final_dir_(final_dir) {
   std::error_code ec;
+  created_ = !fs::exists(final_dir);
   fs::create_directories(final_dir, ec);
   PDVO_THROW_CHECK(fs::is_directory(final_dir), IoError, final_dir << ": cannot create the output folder");
   staging_dir_ = (fs::path(final_dir) / (".partial-" + std::to_string(getpid()))).string();
@@ -119,6 +120,7 @@ StagedOutputDir::StagedOutputDir(const std::string& final_dir) : final_dir_(fina
 StagedOutputDir::~StagedOutputDir() {
   std::error_code ec;
   fs::remove_all(staging_dir_, ec);
+  if (!committed_ && created_) fs::remove(final_dir_, ec);  // only if empty: never what the user made
 }
 
 std::string StagedOutputDir::path(const std::string& name) const { return (fs::path(staging_dir_) / name).string(); }

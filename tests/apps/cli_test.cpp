@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "pdvo/annotations/annotation.h"
@@ -189,6 +191,30 @@ TEST(Cli, SynthWritesASequenceAndRejectsUnknownOptions) {
   EXPECT_EQ(cv::imread(dir / "s/rgb/000002.png").cols, 160);
   EXPECT_EQ(Pdvo("validate " + (dir / "s/annotations"), dir).code, 0);
   EXPECT_TRUE(fs::exists(dir / "s/synth.yaml"));
+}
+
+TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
+  test::TempDir dir;
+  ASSERT_EQ(Pdvo("synth -o " + (dir / "s") + " -n 20 --seed 4 -v warning", dir).code, 0);
+  const CommandResult ok = Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "out") + " -v warning", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(ReadTrajectory(dir / "out/trajectory.txt", TrajectoryFormat::kTum).size(), 20u);
+  const nlohmann::json stats = nlohmann::json::parse(ReadFile(dir / "out/stats.json"));
+  EXPECT_EQ(stats["totals"]["frames"], 20);
+  EXPECT_EQ(stats["frames"].size(), 20u);
+  EXPECT_TRUE(fs::exists(dir / "out/vo.yaml"));
+
+  const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
+  expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"),
+               "gone.yaml");
+  fs::create_directories(dir / "empty");
+  expect_error("vo -v warning -s " + (dir / "empty") + " -o " + (dir / "o2"), "empty");
+  {
+    std::ofstream corrupt(dir / "s/rgb/000007.png", std::ios::trunc);
+    corrupt << "not a png";
+  }
+  expect_error("vo -v warning -s " + (dir / "s") + " -o " + (dir / "o3"), "000007.png");
+  for (const char* o : {"o1", "o2", "o3"}) EXPECT_FALSE(fs::exists(dir / o)) << o << ": no partial output";
 }
 
 }  // namespace

@@ -31,8 +31,8 @@ void WriteImage(const std::string& path, const cv::Mat& image);
 void CheckExists(const std::string& path, const std::string& what = "file");
 
 // An output folder filled through a hidden staging folder inside it: files are written to path(name) and
-// moved into place only by Commit(), so a run that fails leaves no partial output. Files already in the
-// folder are kept, except those the run replaces on Commit().
+// moved into place only by Commit(), so a run that fails leaves no partial output (and no folder, if the run
+// created it). Files already in the folder are kept, except those the run replaces on Commit().
 class StagedOutputDir {
  public:
   explicit StagedOutputDir(const std::string& final_dir);
@@ -48,6 +48,7 @@ class StagedOutputDir {
 
  private:
   std::string final_dir_, staging_dir_;
+  bool created_ = false;  // the folder did not exist before
   bool committed_ = false;
 };
 

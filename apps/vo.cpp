@@ -1,0 +1,94 @@
+// pdvo vo: monocular visual odometry (the IDPP EKF, points only so far) over a sequence.
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/common/dataset.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
+#include "pdvo/common/logging.h"
+#include "pdvo/common/trajectory.h"
+#include "pdvo/vo/odometry.h"
+#include "tool.h"
+
+namespace pdvo::apps {
+
+int RunVo(int argc, char** argv) {
+  CLI::App app("Monocular visual odometry: an EKF with inverse-depth points anchored at keyframes (the IDPP "
+               "system without planar features yet). Frames are undistorted and resized to the working width. "
+               "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals) and vo.yaml "
+               "(the options used) to the output folder.",
+               "pdvo vo");
+  std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", verbosity = "info";
+  std::vector<std::string> overrides;
+  size_t max_frames = 0;
+  app.add_option("--sequence,-s", sequence_path, "Image folder, video, TUM or KITTI folder, or pdvo synth output")
+      ->required();
+  app.add_option("--camera,-c", camera_path, "Camera YAML (default: the sequence's own)");
+  app.add_option("--out,-o", out_dir, "Output folder")->required();
+  app.add_option("--format", format_name, "Trajectory format: tum or kitti")->capture_default_str();
+  app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
+  AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "min_ncc=0.85");
+  AddVerbosityFlag(app, &verbosity);
+  PDVO_PARSE_FLAGS(app, argc, argv);
+  ApplyVerbosity(verbosity);
+
+  const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
+  const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
+  std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
+  Camera camera;
+  if (!camera_path.empty()) {
+    camera = Camera::Read(camera_path);
+  } else {
+    PDVO_THROW_CHECK(sequence->camera().has_value(), InvalidArgument,
+                     sequence_path << ": holds no camera; pass --camera");
+    camera = *sequence->camera();
+  }
+  const Undistorter undistorter(camera);
+  const int width = options.working_width > 0 ? options.working_width : camera.width;
+  const int height = static_cast<int>(std::lround(camera.height * static_cast<double>(width) / camera.width));
+  const Camera working = camera.Undistorted().Rescaled(width, height);
+  vo::Odometry odometry({working.fx, working.fy, working.cx, working.cy}, options);
+  PDVO_LOG(Info) << "vo on " << sequence->Describe() << " at " << width << "x" << height;
+
+  StagedOutputDir out(out_dir);
+  SaveOptions(out.path("vo.yaml"), options, "vo");
+  Trajectory trajectory;
+  nlohmann::json frames = nlohmann::json::array();
+  double seconds = 0;
+  int lost = 0, keyframes = 0;
+  const size_t total = max_frames > 0 ? std::min(max_frames, sequence->size()) : sequence->size();
+  Progress progress("vo", total);
+  Frame frame;
+  while ((max_frames == 0 || trajectory.size() < max_frames) && sequence->Next(&frame)) {
+    PDVO_THROW_CHECK(frame.image.cols == camera.width && frame.image.rows == camera.height, FormatError,
+                     frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
+                                      << ", the camera says " << camera.width << "x" << camera.height);
+    cv::Mat grey, small;
+    cv::cvtColor(undistorter.Apply(frame.image), grey, cv::COLOR_BGR2GRAY);
+    cv::resize(grey, small, cv::Size(width, height), 0, 0, width < camera.width ? cv::INTER_AREA : cv::INTER_LINEAR);
+    const vo::FrameStats s = odometry.Track(small, frame.timestamp);
+    seconds += s.seconds;
+    lost += s.lost;
+    keyframes += s.keyframe;
+    trajectory.push_back({frame.timestamp, odometry.world_from_cam()});
+    frames.push_back({{"t", s.timestamp}, {"seconds", s.seconds}, {"attempted", s.attempted},
+                      {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
+                      {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost}});
+    progress.Step();
+  }
+  progress.Finish();
+  PDVO_THROW_CHECK(!trajectory.empty(), FormatError, sequence_path << ": no frames");
+  WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
+  const double fps = trajectory.size() / std::max(seconds, 1e-9);
+  const nlohmann::json totals = {{"frames", trajectory.size()}, {"tracking_seconds", seconds}, {"fps", fps},
+                                 {"keyframes", keyframes},       {"lost", lost},               {"planes", 0}};
+  WriteFileAtomically(out.path("stats.json"), nlohmann::json({{"totals", totals}, {"frames", frames}}).dump(1) + "\n");
+  out.Commit();
+  std::printf("%zu frames, tracking %.1f frames/s (one thread), %d keyframes, lost %d times; wrote %s\n",
+              trajectory.size(), fps, keyframes, lost, out_dir.c_str());
+  return 0;
+}
+
+}  // namespace pdvo::apps

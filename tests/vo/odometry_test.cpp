@@ -1,0 +1,102 @@
+// The visual odometry on a rendered synthetic street (pdvo_sim): it tracks to the end without losing track, its
+// trajectory after Sim(3) alignment stays within a bound of the ground truth, the same frames give the same
+// trajectory, and bad input is refused.
+#include "pdvo/vo/odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/common/errors.h"
+#include "pdvo/eval/trajectory_error.h"
+#include "pdvo/sim/renderer.h"
+#include "pdvo/sim/synth.h"
+
+namespace pdvo::vo {
+namespace {
+
+struct Street {
+  sim::SynthOptions options;
+  sim::Street street;
+  Trajectory walk;
+  std::vector<cv::Mat> grey;
+  Camera camera;
+};
+
+// 150 frames at 30 frames/s: 7 m of walking.
+const Street& TestStreet() {
+  static const Street s = [] {
+    Street s;
+    constexpr int kFrames = 150;
+    s.street = sim::GenerateStreet(s.options.street, 40, 3);
+    s.walk = sim::WalkStreet(s.street, s.options.walk, kFrames, 3);
+    s.camera = s.options.MakeCamera();
+    const sim::Renderer renderer(s.street, s.camera, s.options.render, 3);
+    for (const StampedPose& pose : s.walk) {
+      sim::RenderedFrame frame;
+      renderer.Render({pose.world_from_cam}, pose.timestamp, s.grey.size(), &frame);
+      cv::Mat grey;
+      cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
+      s.grey.push_back(grey);
+    }
+    return s;
+  }();
+  return s;
+}
+
+Trajectory RunOdometry(const Street& s, std::vector<FrameStats>* stats) {
+  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  Trajectory estimate;
+  for (size_t k = 0; k < s.grey.size(); ++k) {
+    stats->push_back(odometry.Track(s.grey[k], s.walk[k].timestamp));
+    estimate.push_back({s.walk[k].timestamp, odometry.world_from_cam()});
+  }
+  return estimate;
+}
+
+TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
+  const Street& s = TestStreet();
+  std::vector<FrameStats> stats;
+  const Trajectory estimate = RunOdometry(s, &stats);
+  for (const FrameStats& f : stats) {
+    EXPECT_FALSE(f.lost) << "at " << f.timestamp;
+    EXPECT_GE(f.points, 1);
+  }
+  int measured = 0;
+  for (const FrameStats& f : stats) measured += f.measurements;
+  EXPECT_GT(measured / static_cast<double>(stats.size()), 10);  // features are found, not just predicted
+  const AteResult ate = ComputeAte(s.walk, estimate, Alignment::kSim3, 1e-3);
+  const double length = PathLength(s.walk);
+  EXPECT_EQ(ate.matched, s.walk.size());
+  // Measured 1.6% of the path on this street (0.7-2.0% over 1,000 frames of others, see README.md); a constant
+  // velocity extrapolation of the first frame would be off by metres. The target of 1% is not met yet.
+  EXPECT_LT(ate.translation.rmse, 0.03 * length) << "path " << length << " m";
+  RecordProperty("ate_rmse_percent_of_path", std::to_string(100 * ate.translation.rmse / length));
+}
+
+TEST(Odometry, TheSameFramesGiveTheSameTrajectory) {
+  const Street& s = TestStreet();
+  std::vector<FrameStats> a_stats, b_stats;
+  const Trajectory a = RunOdometry(s, &a_stats), b = RunOdometry(s, &b_stats);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].world_from_cam.translation, b[k].world_from_cam.translation) << k;
+    EXPECT_EQ(a[k].world_from_cam.rotation.coeffs(), b[k].world_from_cam.rotation.coeffs()) << k;
+  }
+}
+
+TEST(Odometry, RefusesBadFrames) {
+  const Street& s = TestStreet();
+  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  EXPECT_THROW(odometry.Track(cv::Mat(240, 320, CV_8UC3), 0), InvalidArgument);  // colour
+  EXPECT_THROW(odometry.Track(cv::Mat(), 0), InvalidArgument);
+  odometry.Track(s.grey[0], 1.0);
+  EXPECT_THROW(odometry.Track(s.grey[1], 1.0), InvalidArgument);                   // time did not advance
+  EXPECT_THROW(odometry.Track(s.grey[1](cv::Rect(0, 0, 100, 100)).clone(), 2.0), InvalidArgument);  // size
+  VoOptions bad;
+  bad.border = bad.patch_half;  // patches would leave the image
+  EXPECT_THROW(Odometry({1, 1, 0, 0}, bad), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo::vo
