@@ -38,37 +38,98 @@ int Filter::AddReference() {
   return id;
 }
 
+void Filter::Augment(const Eigen::VectorXd& variances) {
+  const Eigen::Index n = size(), k = variances.size();
+  covariance_.conservativeResize(n + k, n + k);
+  covariance_.bottomRows(k).setZero();
+  covariance_.rightCols(k).setZero();
+  covariance_.bottomRightCorner(k, k).diagonal() = variances;
+}
+
 int Filter::AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho) {
   auto r = references_.find(reference);
   PDVO_THROW_CHECK(r != references_.end(), InvalidArgument, "filter: no reference camera " << reference);
   PDVO_THROW_CHECK(sigma_rho > 0 && std::isfinite(rho), InvalidArgument, "filter: bad inverse depth prior");
-  const int n = size();
-  covariance_.conservativeResize(n + 1, n + 1);
-  covariance_.row(n).setZero();
-  covariance_.col(n).setZero();
-  covariance_(n, n) = sigma_rho * sigma_rho;
+  const int offset = size();
+  Augment(Eigen::VectorXd::Constant(1, sigma_rho * sigma_rho));
   ++r->second.users;
   const int id = next_id_++;
-  points_[id] = {reference, ray.normalized(), rho, n};
+  points_[id] = {reference, ray.normalized(), rho, offset};
+  return id;
+}
+
+int Filter::AddPlane(int reference, const InversePlane& plane, double sigma_normal, double sigma_inverse_distance) {
+  auto r = references_.find(reference);
+  PDVO_THROW_CHECK(r != references_.end(), InvalidArgument, "filter: no reference camera " << reference);
+  PDVO_THROW_CHECK(plane.normal.norm() > 0 && plane.normal.allFinite() && std::isfinite(plane.inverse_distance) &&
+                       sigma_normal > 0 && sigma_inverse_distance > 0,
+                   InvalidArgument, "filter: bad plane prior");
+  const int offset = size();
+  Eigen::Vector4d variances;
+  variances << Eigen::Vector3d::Constant(sigma_normal * sigma_normal), sigma_inverse_distance * sigma_inverse_distance;
+  Augment(variances);
+  ++r->second.users;
+  const int id = next_id_++;
+  planes_[id] = {reference, plane, offset};
   return id;
 }
 
 void Filter::RemovePoint(int id) {
   auto p = points_.find(id);
   PDVO_THROW_CHECK(p != points_.end(), InvalidArgument, "filter: no point " << id);
-  std::vector<int> dropped = {p->second.offset};
-  auto r = references_.find(p->second.reference);
+  const std::vector<int> dropped = {p->second.offset};
+  const int reference = p->second.reference;
+  points_.erase(p);
+  Remove(dropped, reference);
+}
+
+void Filter::RemovePlane(int id) {
+  auto p = planes_.find(id);
+  PDVO_THROW_CHECK(p != planes_.end(), InvalidArgument, "filter: no plane " << id);
+  const int o = p->second.offset;
+  const std::vector<int> dropped = {o, o + 1, o + 2, o + 3};
+  const int reference = p->second.reference;
+  planes_.erase(p);
+  Remove(dropped, reference);
+}
+
+void Filter::Remove(std::vector<int> dropped, int reference) {
+  auto r = references_.find(reference);
   if (--r->second.users == 0) {
     for (int k = 0; k < 6; ++k) dropped.push_back(r->second.offset + k);
     references_.erase(r);
   }
-  points_.erase(p);
   std::vector<int> keep;
   for (int i = 0; i < size(); ++i) {
     if (std::find(dropped.begin(), dropped.end(), i) == dropped.end()) keep.push_back(i);
   }
   covariance_ = Eigen::MatrixXd(covariance_(keep, keep));
   Renumber();
+}
+
+int Filter::PlaneToPoint(int plane_id, const Eigen::Vector3d& ray) {
+  auto it = planes_.find(plane_id);
+  PDVO_THROW_CHECK(it != planes_.end(), InvalidArgument, "filter: no plane " << plane_id);
+  const Plane plane = it->second;
+  const Eigen::Vector3d m = ray.normalized();
+  const double rho = plane.plane.InverseDepthAlong(m);
+  // rho = -rho_p (n^ . m): its Jacobian with respect to (n, rho_p), as in ProjectPlanePoint.
+  const double norm = plane.plane.normal.norm();
+  const Eigen::Vector3d unit = plane.plane.normal / norm;
+  Eigen::RowVector4d j;
+  j << -plane.plane.inverse_distance * m.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm,
+      -unit.dot(m);
+  const int n = size();
+  const Eigen::RowVectorXd cross = j * covariance_.middleRows<4>(plane.offset);  // with the whole state
+  Augment(Eigen::VectorXd::Zero(1));
+  covariance_.row(n).head(n) = cross;
+  covariance_.col(n).head(n) = cross.transpose();
+  covariance_(n, n) = (j * covariance_.block<4, 4>(plane.offset, plane.offset) * j.transpose())(0, 0);
+  ++references_.at(plane.reference).users;
+  const int id = next_id_++;
+  points_[id] = {plane.reference, m, rho, n};
+  RemovePlane(plane_id);
+  return id;
 }
 
 void Filter::Renumber() {
@@ -81,6 +142,7 @@ void Filter::Renumber() {
   std::vector<Block> blocks;
   for (auto& [id, r] : references_) blocks.push_back({r.offset, &r.offset, 6});
   for (auto& [id, p] : points_) blocks.push_back({p.offset, &p.offset, 1});
+  for (auto& [id, p] : planes_) blocks.push_back({p.offset, &p.offset, 4});
   std::sort(blocks.begin(), blocks.end(), [](const Block& a, const Block& b) { return a.old_offset < b.old_offset; });
   int next = 12;
   for (Block& b : blocks) {
@@ -106,6 +168,25 @@ bool Filter::PredictPoint(const Pinhole& camera, int id, Eigen::Vector2d* pixel,
   return true;
 }
 
+bool Filter::PredictPlanePoint(const Pinhole& camera, int id, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
+                               Eigen::MatrixXd* jacobian) const {
+  const Plane& p = planes_.at(id);
+  const Reference& r = references_.at(p.reference);
+  ProjectionJacobians j;
+  Eigen::Matrix<double, 2, 4> jp;
+  if (!ProjectPlanePoint(camera, camera_.world_from_cam(), r.world_from_cam, p.plane, ray, pixel,
+                         jacobian ? &j : nullptr, jacobian ? &jp : nullptr)) {
+    return false;
+  }
+  if (jacobian) {
+    jacobian->setZero(2, size());
+    jacobian->leftCols<6>() = j.current;
+    jacobian->middleCols<6>(r.offset) = j.reference;
+    jacobian->middleCols<4>(p.offset) = jp;
+  }
+  return true;
+}
+
 double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements) {
   if (measurements.empty()) return 0;
   const int m = 2 * static_cast<int>(measurements.size()), n = size();
@@ -114,8 +195,10 @@ double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>
   for (size_t k = 0; k < measurements.size(); ++k) {
     Eigen::Vector2d predicted;
     Eigen::MatrixXd jk;
-    PDVO_THROW_CHECK(PredictPoint(camera, measurements[k].point, &predicted, &jk), InvalidArgument,
-                     "filter: point " << measurements[k].point << " is behind the camera");
+    const PointMeasurement& z = measurements[k];
+    const bool in_front = planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, &predicted, &jk)
+                                                 : PredictPoint(camera, z.point, &predicted, &jk);
+    PDVO_THROW_CHECK(in_front, InvalidArgument, "filter: feature " << z.point << " is not in front of the camera");
     h.middleRows<2>(2 * k) = jk;
     innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
     noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
@@ -141,6 +224,10 @@ void Filter::Apply(const Eigen::VectorXd& delta) {
                                r.world_from_cam.translation + delta.segment<3>(r.offset));
   }
   for (auto& [id, p] : points_) p.inverse_depth += delta[p.offset];
+  for (auto& [id, p] : planes_) {
+    p.plane.normal += delta.segment<3>(p.offset);
+    p.plane.inverse_distance += delta[p.offset + 3];
+  }
 }
 
 }  // namespace pdvo::vo

@@ -1,8 +1,10 @@
 // The EKF's state and its operations (the paper's section IV): the camera (motion.h), reference cameras (the
-// poses of keyframes at which features were initialised, shared by those features) and inverse-depth points
-// anchored at them (idpp.h), with one dense covariance over the error state
-//   [camera 12 | per reference camera 6 (dp, dtheta) | per point 1 (rho)]   in the order they were added.
-// Features and reference cameras are named by ids that stay valid while the rest of the state changes.
+// poses of keyframes at which features were initialised, shared by those features), and inverse-depth points
+// and planes anchored at them (idpp.h), with one dense covariance over the error state
+//   [camera 12 | per reference camera 6 (dp, dtheta) | per point 1 (rho) | per plane 4 (n, rho_p)]
+// in the order they were added. A plane's points are keyframe rays outside the state: a plane costs four
+// values however many points it holds. Features and reference cameras are named by ids (one sequence for all)
+// that stay valid while the rest of the state changes.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,11 +21,12 @@ struct MotionNoise {
   double angular_acceleration = 2.0;  // rad/s^2
 };
 
-// One pixel measurement of a point: where it was found and its noise.
+// One pixel measurement of a point, or of one of a plane's points (given by its keyframe ray).
 struct PointMeasurement {
-  int point = -1;              // point id
+  int point = -1;              // point id, or plane id
   Eigen::Vector2d pixel;       // measured, current camera (pinhole, undistorted)
   double sigma = 1.0;          // pixels
+  Eigen::Vector3d ray = Eigen::Vector3d::Zero();  // planes: the measured point's ray (unit, reference frame)
 };
 
 class Filter {
@@ -39,6 +42,11 @@ class Filter {
     double inverse_depth = 0;
     int offset = 0;
   };
+  struct Plane {
+    int reference = -1;
+    InversePlane plane;   // reference camera frame
+    int offset = 0;
+  };
 
   Filter(const CameraState& camera, const Matrix12d& covariance);
 
@@ -47,6 +55,7 @@ class Filter {
   int size() const { return static_cast<int>(covariance_.rows()); }
   const std::map<int, Reference>& references() const { return references_; }
   const std::map<int, Point>& points() const { return points_; }
+  const std::map<int, Plane>& planes() const { return planes_; }
 
   // Constant velocity over dt seconds (PredictCamera), with its process noise.
   void Predict(double dt, const MotionNoise& noise);
@@ -56,12 +65,21 @@ class Filter {
   // A point on the ray (unit, reference frame) at inverse depth rho with standard deviation sigma_rho,
   // uncorrelated with the rest of the state.
   int AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho);
-  // Removes a point; a reference camera goes when its last point does.
+  // A plane with independent standard deviations for each normal component and its inverse distance.
+  int AddPlane(int reference, const InversePlane& plane, double sigma_normal, double sigma_inverse_distance);
+  // Removes a point or a plane; a reference camera goes when its last feature does.
   void RemovePoint(int point);
+  void RemovePlane(int plane);
+  // A plane that could not grow becomes a point on `ray` (unit, reference frame): the point's inverse depth is
+  // where the ray meets the plane, with the covariance that follows (first order). Returns the point's id.
+  int PlaneToPoint(int plane, const Eigen::Vector3d& ray);
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.
   bool PredictPoint(const Pinhole& camera, int point, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const;
+  // The same for the point of a plane on `ray`; false also if the ray does not meet the plane in front.
+  bool PredictPlanePoint(const Pinhole& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
+                         Eigen::MatrixXd* jacobian) const;
 
   // One batched EKF update with the measurements (points must exist and be in front of the camera); returns
   // the normalised innovation squared of the batch (chi-square with 2 x count degrees of freedom).
@@ -71,12 +89,16 @@ class Filter {
   void Apply(const Eigen::VectorXd& delta);
 
  private:
+  void Remove(std::vector<int> dropped, int reference);
   void Renumber();
+  // Grows the covariance by variances.size() rows and columns, zero but for `variances` on the new diagonal.
+  void Augment(const Eigen::VectorXd& variances);
 
   CameraState camera_;
   Eigen::MatrixXd covariance_;
   std::map<int, Reference> references_;
   std::map<int, Point> points_;
+  std::map<int, Plane> planes_;
   int next_id_ = 0;
 };
 
