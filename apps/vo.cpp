@@ -1,4 +1,4 @@
-// pdvo vo: monocular visual odometry (the IDPP EKF, points only so far) over a sequence.
+// pdvo vo: monocular visual odometry (the IDPP EKF: inverse-depth points and planes) over a sequence.
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -15,8 +15,8 @@
 namespace pdvo::apps {
 
 int RunVo(int argc, char** argv) {
-  CLI::App app("Monocular visual odometry: an EKF with inverse-depth points anchored at keyframes (the IDPP "
-               "system without planar features yet). Frames are undistorted and resized to the working width. "
+  CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
+               "(the IDPP system; --set mode=points for points only). Frames are undistorted and resized to the working width. "
                "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals) and vo.yaml "
                "(the options used) to the output folder.",
                "pdvo vo");
@@ -75,6 +75,7 @@ int RunVo(int argc, char** argv) {
     trajectory.push_back({frame.timestamp, odometry.world_from_cam()});
     frames.push_back({{"t", s.timestamp}, {"seconds", s.seconds}, {"attempted", s.attempted},
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
+                      {"plane_points", s.plane_points},
                       {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost}});
     progress.Step();
   }
@@ -82,12 +83,21 @@ int RunVo(int argc, char** argv) {
   PDVO_THROW_CHECK(!trajectory.empty(), FormatError, sequence_path << ": no frames");
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const double fps = trajectory.size() / std::max(seconds, 1e-9);
-  const nlohmann::json totals = {{"frames", trajectory.size()}, {"tracking_seconds", seconds}, {"fps", fps},
-                                 {"keyframes", keyframes},       {"lost", lost},               {"planes", 0}};
+  const vo::MappingStats mapping = odometry.mapping();
+  const nlohmann::json totals = {{"frames", trajectory.size()},
+                                 {"tracking_seconds", seconds},
+                                 {"fps", fps},
+                                 {"keyframes", keyframes},
+                                 {"lost", lost},
+                                 {"planes", mapping.planes},
+                                 {"points_per_plane", mapping.points_per_plane},
+                                 {"mean_plane_area_px", mapping.mean_plane_area}};
   WriteFileAtomically(out.path("stats.json"), nlohmann::json({{"totals", totals}, {"frames", frames}}).dump(1) + "\n");
   out.Commit();
-  std::printf("%zu frames, tracking %.1f frames/s (one thread), %d keyframes, lost %d times; wrote %s\n",
-              trajectory.size(), fps, keyframes, lost, out_dir.c_str());
+  std::printf("%zu frames, tracking %.1f frames/s (one thread), %d keyframes, lost %d times; %d planes, %.1f "
+              "points per plane, mean area %.0f px; wrote %s\n",
+              trajectory.size(), fps, keyframes, lost, mapping.planes, mapping.points_per_plane,
+              mapping.mean_plane_area, out_dir.c_str());
   return 0;
 }
 

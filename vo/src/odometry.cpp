@@ -20,6 +20,11 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(max_measurements >= 1 && min_features >= 1 && new_features >= 1 && min_distance >= 1);
   PDVO_CHECK_OPTION(max_misses >= 1 && lost_after >= 1);
   PDVO_CHECK_OPTION(ransac_hypotheses >= 1 && ransac_threshold > 0);
+  PDVO_CHECK_OPTION(mode == "idpp" || mode == "points");
+  PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
+  PDVO_CHECK_OPTION(candidate_frames >= 1 && candidate_tolerance > 0 && plane_grow_frames >= 1 &&
+                    min_plane_points >= 3);
+  PDVO_CHECK_OPTION(plane_sigma_normal > 0);
   PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
   return true;
@@ -29,21 +34,47 @@ struct Odometry::Impl {
   Pinhole camera;
   VoOptions o;
   std::unique_ptr<Filter> filter;
-  std::map<int, std::shared_ptr<const cv::Mat>> keyframe_of_reference;
-  struct Track {
-    Eigen::Vector2d keyframe_pixel;
-    int misses = 0;
-  };
-  std::map<int, Track> tracks;  // by point id
+  cv::Size size;
+  std::mt19937 rng{1};  // RANSAC; fixed seed: the same frames give the same trajectory
   double last_time = 0;
   bool started = false;
   int frames_without_measurements = 0;
-  cv::Size size;
-  std::mt19937 rng{1};  // RANSAC; fixed seed: the same frames give the same trajectory
+
+  // Per reference camera: its keyframe image and the corners found in it (planes grow over these).
+  struct Corner {
+    Eigen::Vector2d pixel;
+    bool used = false;
+  };
+  struct Keyframe {
+    cv::Mat grey;
+    std::vector<Corner> corners;
+  };
+  std::map<int, Keyframe> keyframes;
+  struct PointTrack {
+    Eigen::Vector2d keyframe_pixel;
+    int misses = 0;
+  };
+  std::map<int, PointTrack> point_tracks;  // by point id
+  struct PlanePoint {
+    Eigen::Vector2d keyframe_pixel;
+    Eigen::Vector3d ray;
+    int count = 0;  // members: consecutive misses; candidates: consecutive consistent matches
+  };
+  struct PlaneTrack {
+    std::vector<PlanePoint> members, candidates;  // members[0] is the seed
+    int age = 0;                                  // frames since the plane was made
+  };
+  std::map<int, PlaneTrack> plane_tracks;  // by plane id
+  std::map<int, PlaneRecord> records;      // every plane that reached min_plane_points, by plane id
 
   bool Inside(const Eigen::Vector2d& p) const {
     return p.x() >= o.border && p.y() >= o.border && p.x() < size.width - o.border &&
            p.y() < size.height - o.border;
+  }
+
+  bool Predict(const Filter& f, const PointMeasurement& z, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
+    return f.planes().count(z.point) ? f.PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
+                                     : f.PredictPoint(camera, z.point, pixel, jacobian);
   }
 
   void Start(const cv::Mat& grey, const CameraState& at) {
@@ -54,40 +85,26 @@ struct Odometry::Impl {
     sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6),
         Eigen::Vector3d::Constant(o.initial_velocity_sigma), Eigen::Vector3d::Constant(o.angular_acceleration);
     filter = std::make_unique<Filter>(rest, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
-    keyframe_of_reference.clear();
-    tracks.clear();
+    keyframes.clear();
+    point_tracks.clear();
+    plane_tracks.clear();
     frames_without_measurements = 0;
     MakeKeyframe(grey);
   }
 
-  // New points at the strongest corners at least min_distance from the visible features.
-  bool MakeKeyframe(const cv::Mat& grey) {
-    cv::Mat mask(grey.size(), CV_8U, cv::Scalar(0));
-    mask(cv::Rect(o.border, o.border, grey.cols - 2 * o.border, grey.rows - 2 * o.border)).setTo(255);
+  // Keyframe pixels of the features measured in the current view, predicted.
+  std::vector<Eigen::Vector2d> VisibleFeatures() const {
+    std::vector<Eigen::Vector2d> out;
+    Eigen::Vector2d pixel;
     for (const auto& [id, p] : filter->points()) {
-      Eigen::Vector2d pixel;
-      if (filter->PredictPoint(camera, id, &pixel, nullptr)) {
-        cv::circle(mask, cv::Point(cvRound(pixel.x()), cvRound(pixel.y())), static_cast<int>(o.min_distance),
-                   cv::Scalar(0), cv::FILLED);
+      if (filter->PredictPoint(camera, id, &pixel, nullptr) && Inside(pixel)) out.push_back(pixel);
+    }
+    for (const auto& [id, t] : plane_tracks) {
+      for (const PlanePoint& m : t.members) {
+        if (filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel)) out.push_back(pixel);
       }
     }
-    std::vector<cv::Point2f> corners;
-    cv::goodFeaturesToTrack(grey, corners, o.new_features, 0.01, o.min_distance, mask);
-    if (corners.empty()) return false;
-    // New points start at the median inverse depth of the converged points in view, with the same relative
-    // uncertainty as the configured prior: priors in the map's own (drifting, monocular) scale.
-    double rho = o.initial_inverse_depth;
-    const std::vector<double> in_view = ConvergedInverseDepths();
-    if (in_view.size() >= 5) rho = in_view[in_view.size() / 2];
-    const double sigma = o.initial_inverse_depth_sigma / o.initial_inverse_depth * rho;
-    const int reference = filter->AddReference();
-    keyframe_of_reference[reference] = std::make_shared<const cv::Mat>(grey.clone());
-    for (const cv::Point2f& c : corners) {
-      const Eigen::Vector2d pixel(c.x, c.y);
-      const int id = filter->AddPoint(reference, camera.Ray(pixel), rho, sigma);
-      tracks[id] = {pixel, 0};
-    }
-    return true;
+    return out;
   }
 
   // Inverse distances from the current camera of the points whose inverse depth is known to 30%, sorted.
@@ -104,14 +121,94 @@ struct Odometry::Impl {
     return out;
   }
 
-  void Remove(int id) {
-    const int reference = filter->points().at(id).reference;
-    filter->RemovePoint(id);
-    tracks.erase(id);
-    if (!filter->references().count(reference)) keyframe_of_reference.erase(reference);
+  // A keyframe: corners away from the visible features; in idpp mode up to max_new_planes of them, where
+  // corners are densest, seed planes (fronto-parallel, facing the keyframe); the strongest others become points.
+  // Priors: the median inverse depth of the converged points in view (the map keeps its own scale).
+  bool MakeKeyframe(const cv::Mat& grey) {
+    cv::Mat mask(grey.size(), CV_8U, cv::Scalar(0));
+    mask(cv::Rect(o.border, o.border, grey.cols - 2 * o.border, grey.rows - 2 * o.border)).setTo(255);
+    for (const Eigen::Vector2d& p : VisibleFeatures()) {
+      cv::circle(mask, cv::Point(cvRound(p.x()), cvRound(p.y())), static_cast<int>(o.min_distance), cv::Scalar(0),
+                 cv::FILLED);
+    }
+    std::vector<cv::Point2f> found;
+    cv::goodFeaturesToTrack(grey, found, 4 * o.new_features, 0.01, o.min_distance, mask);
+    if (found.empty()) return false;
+    double rho = o.initial_inverse_depth;
+    const std::vector<double> in_view = ConvergedInverseDepths();
+    if (in_view.size() >= 5) rho = in_view[in_view.size() / 2];
+    const double sigma = o.initial_inverse_depth_sigma / o.initial_inverse_depth * rho;
+
+    const int reference = filter->AddReference();
+    Keyframe& keyframe = keyframes[reference];
+    keyframe.grey = grey.clone();
+    for (const cv::Point2f& c : found) keyframe.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
+    std::vector<Corner>& corners = keyframe.corners;
+    std::vector<int> seeds;
+    if (o.mode == "idpp") {
+      std::vector<std::pair<int, int>> density;  // (corners within grow_radius, index)
+      for (size_t i = 0; i < corners.size(); ++i) {
+        int n = 0;
+        for (const Corner& c : corners) n += (c.pixel - corners[i].pixel).norm() < o.grow_radius;
+        density.emplace_back(-n, static_cast<int>(i));
+      }
+      std::sort(density.begin(), density.end());
+      for (const auto& [minus_n, i] : density) {
+        if (static_cast<int>(seeds.size()) >= o.max_new_planes || -minus_n <= o.min_plane_points) break;
+        const bool apart = std::all_of(seeds.begin(), seeds.end(), [&](int s) {
+          return (corners[s].pixel - corners[i].pixel).norm() > 2 * o.grow_radius;
+        });
+        if (apart) seeds.push_back(i);
+      }
+    }
+    for (int i : seeds) {
+      corners[i].used = true;
+      const Eigen::Vector3d ray = camera.Ray(corners[i].pixel);
+      const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, sigma);
+      plane_tracks[id].members.push_back({corners[i].pixel, ray, 0});
+    }
+    // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
+    int points = 0;
+    for (Corner& c : corners) {
+      if (c.used || points + static_cast<int>(seeds.size()) >= o.new_features) continue;
+      c.used = true;
+      ++points;
+      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma)] = {c.pixel, 0};
+    }
+    return true;
   }
 
-  // NCC search for `templ` (CV_32F) in `grey` within the ellipse of S around `predicted`.
+  void RemovePoint(int id) {
+    const int reference = filter->points().at(id).reference;
+    filter->RemovePoint(id);
+    point_tracks.erase(id);
+    if (!filter->references().count(reference)) keyframes.erase(reference);
+  }
+
+  void RemovePlane(int id) {
+    const int reference = filter->planes().at(id).reference;
+    filter->RemovePlane(id);
+    plane_tracks.erase(id);
+    if (!filter->references().count(reference)) keyframes.erase(reference);
+  }
+
+  // The area (keyframe pixels) of the convex hull of a plane's members.
+  static double Area(const PlaneTrack& t) {
+    if (t.members.size() < 3) return 0;
+    std::vector<cv::Point2f> pixels, hull;
+    for (const PlanePoint& m : t.members) pixels.emplace_back(m.keyframe_pixel.x(), m.keyframe_pixel.y());
+    cv::convexHull(pixels, hull);
+    return cv::contourArea(hull);
+  }
+
+  void Record(int id, const PlaneTrack& t) {
+    if (static_cast<int>(t.members.size()) < o.min_plane_points) return;
+    PlaneRecord& r = records[id];
+    r.points = std::max(r.points, static_cast<int>(t.members.size()));
+    r.area = std::max(r.area, Area(t));
+  }
+
+    // NCC search for `templ` (CV_32F) in `grey` within the ellipse of S around `predicted`.
   bool Search(const cv::Mat& grey, const cv::Mat& templ, const Eigen::Vector2d& predicted, const Eigen::Matrix2d& s,
               Eigen::Vector2d* found) const {
     const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff();
@@ -156,37 +253,6 @@ struct Odometry::Impl {
     return true;
   }
 
-  FrameStats Track(const cv::Mat& grey, double timestamp) {
-    FrameStats stats;
-    stats.timestamp = timestamp;
-    if (!started) {
-      size = grey.size();
-      Start(grey, CameraState());
-      started = true;
-      stats.keyframe = true;
-    } else {
-      PDVO_THROW_CHECK(grey.size() == size, InvalidArgument, "odometry: frames changed size");
-      PDVO_THROW_CHECK(timestamp > last_time, InvalidArgument,
-                       "odometry: timestamps must increase (" << last_time << " then " << timestamp << ")");
-      filter->Predict(timestamp - last_time, {o.linear_acceleration, o.angular_acceleration});
-      Measure(grey, &stats);
-      if (!filter->covariance().allFinite() || !filter->camera().position.allFinite() ||
-          frames_without_measurements >= o.lost_after) {
-        stats.lost = true;
-        CameraState at = filter->camera();
-        if (!at.position.allFinite() || !at.orientation.coeffs().allFinite()) at = CameraState();
-        Start(grey, at);
-        stats.keyframe = true;
-      } else if (static_cast<int>(filter->points().size()) < o.min_features) {
-        stats.keyframe = MakeKeyframe(grey);
-      }
-    }
-    last_time = timestamp;
-    stats.points = static_cast<int>(filter->points().size());
-    stats.state_size = filter->size();
-    return stats;
-  }
-
   // 1-point RANSAC (Civera et al. 2010): each hypothesis is the state after an update with one measurement;
   // the one that brings most other measurements within `ransac_threshold` px gives the inliers, which update
   // the filter; then any other measurement whose innovation is now within the 99% gate updates it too.
@@ -197,7 +263,7 @@ struct Odometry::Impl {
       std::vector<PointMeasurement> in;
       for (const PointMeasurement& z : all) {
         Eigen::Vector2d predicted;
-        if (f.PredictPoint(camera, z.point, &predicted, nullptr) && (predicted - z.pixel).norm() < threshold) {
+        if (Predict(f, z, &predicted, nullptr) && (predicted - z.pixel).norm() < threshold) {
           in.push_back(z);
         }
       }
@@ -220,7 +286,7 @@ struct Odometry::Impl {
       if (std::any_of(best.begin(), best.end(), [&](const PointMeasurement& b) { return b.point == z.point; })) continue;
       Eigen::Vector2d predicted;
       Eigen::MatrixXd jacobian;
-      if (!filter->PredictPoint(camera, z.point, &predicted, &jacobian)) continue;
+      if (!Predict(*filter, z, &predicted, &jacobian)) continue;
       Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
       s.diagonal().array() += z.sigma * z.sigma;
       const Eigen::Vector2d v = z.pixel - predicted;
@@ -230,43 +296,173 @@ struct Odometry::Impl {
     return static_cast<int>(best.size() + rescued.size());
   }
 
+  // Searches for a feature whose pixel is predicted with `jacobian`, warping its keyframe patch by `h`.
+  bool Find(const cv::Mat& grey, const cv::Mat& keyframe, const Eigen::Matrix3d& h, const Eigen::Vector2d& predicted,
+            const Eigen::MatrixXd& jacobian, Eigen::Vector2d* found) const {
+    Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
+    s.diagonal().array() += o.pixel_sigma * o.pixel_sigma;
+    cv::Mat templ;
+    return WarpPatch(keyframe, h, predicted, o.patch_half, &templ) && Search(grey, templ, predicted, s, found);
+  }
+
   void Measure(const cv::Mat& grey, FrameStats* stats) {
-    // Features that left the view (or went behind the camera) leave the filter.
+    const Rigid3d current = filter->camera().world_from_cam();
+    Eigen::Vector2d pixel;
+    // Points that left the view (or went behind the camera) leave the filter; planes whose members all left
+    // are kept in the record and leave the filter.
     std::vector<int> gone;
     for (const auto& [id, p] : filter->points()) {
-      Eigen::Vector2d pixel;
       if (!filter->PredictPoint(camera, id, &pixel, nullptr) || !Inside(pixel)) gone.push_back(id);
     }
-    for (int id : gone) Remove(id);
+    for (int id : gone) RemovePoint(id);
+    gone.clear();
+    for (const auto& [id, t] : plane_tracks) {
+      const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
+        return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel);
+      });
+      if (!any) gone.push_back(id);
+    }
+    for (int id : gone) {
+      Record(id, plane_tracks.at(id));
+      RemovePlane(id);
+    }
 
-    const Rigid3d current = filter->camera().world_from_cam();
     std::vector<PointMeasurement> measurements;
-    std::vector<int> missed;
+    std::vector<int> missed_points;
+    Eigen::MatrixXd jacobian;
     for (const auto& [id, p] : filter->points()) {
       if (stats->attempted >= o.max_measurements) break;
       ++stats->attempted;
-      Eigen::Vector2d predicted;
-      Eigen::MatrixXd jacobian;
-      filter->PredictPoint(camera, id, &predicted, &jacobian);
-      Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
-      s.diagonal().array() += o.pixel_sigma * o.pixel_sigma;
-      const Filter::Reference& reference = filter->references().at(p.reference);
-      const Eigen::Matrix3d h = PlaneHomography(camera, current, reference.world_from_cam,
+      filter->PredictPoint(camera, id, &pixel, &jacobian);
+      const Eigen::Matrix3d h = PlaneHomography(camera, current, filter->references().at(p.reference).world_from_cam,
                                                 FrontoParallel(p.ray, std::max(p.inverse_depth, 1e-3)));
-      cv::Mat templ;
       Eigen::Vector2d found;
-      if (WarpPatch(*keyframe_of_reference.at(p.reference), h, predicted, o.patch_half, &templ) &&
-          Search(grey, templ, predicted, s, &found)) {
-        measurements.push_back({id, found, o.pixel_sigma});
-        tracks[id].misses = 0;
-      } else if (++tracks[id].misses > o.max_misses) {
-        missed.push_back(id);
+      if (Find(grey, keyframes.at(p.reference).grey, h, pixel, jacobian, &found)) {
+        measurements.push_back({id, found, o.pixel_sigma, Eigen::Vector3d::Zero()});
+        point_tracks[id].misses = 0;
+      } else if (++point_tracks[id].misses > o.max_misses) {
+        missed_points.push_back(id);
+      }
+    }
+    for (auto& [id, t] : plane_tracks) {
+      const Filter::Plane& plane = filter->planes().at(id);
+      const Eigen::Matrix3d h =
+          PlaneHomography(camera, current, filter->references().at(plane.reference).world_from_cam, plane.plane);
+      for (PlanePoint& m : t.members) {
+        if (stats->attempted >= o.max_measurements) break;
+        if (!filter->PredictPlanePoint(camera, id, m.ray, &pixel, &jacobian) || !Inside(pixel)) continue;
+        ++stats->attempted;
+        Eigen::Vector2d found;
+        if (Find(grey, keyframes.at(plane.reference).grey, h, pixel, jacobian, &found)) {
+          measurements.push_back({id, found, o.pixel_sigma, m.ray});
+          m.count = 0;
+        } else {
+          ++m.count;
+        }
       }
     }
     const int used = UpdateRobustly(measurements);
     frames_without_measurements = used == 0 ? frames_without_measurements + 1 : 0;
     stats->measurements = used;
-    for (int id : missed) Remove(id);
+    for (int id : missed_points) RemovePoint(id);
+    if (o.mode == "idpp") GrowPlanes(grey);
+  }
+
+  // Members missed too often leave their plane; candidates measured consistently with the plane (found within
+  // candidate_tolerance px of where it predicts them) for candidate_frames frames join it, the others are dropped; each plane takes up to
+  // new_plane_points new candidates a frame from its keyframe's corners near its members; a plane that has not
+  // reached min_plane_points after plane_grow_frames becomes a point.
+  void GrowPlanes(const cv::Mat& grey) {
+    const Rigid3d current = filter->camera().world_from_cam();
+    std::vector<int> to_points, empty;
+    Eigen::Vector2d pixel;
+    Eigen::MatrixXd jacobian;
+    for (auto& [id, t] : plane_tracks) {
+      ++t.age;
+      std::erase_if(t.members, [&](const PlanePoint& m) { return m.count > o.max_misses; });
+      if (t.members.empty()) {
+        empty.push_back(id);
+        continue;
+      }
+      const Filter::Plane& plane = filter->planes().at(id);
+      Keyframe& keyframe = keyframes.at(plane.reference);
+      const Eigen::Matrix3d h =
+          PlaneHomography(camera, current, filter->references().at(plane.reference).world_from_cam, plane.plane);
+      std::vector<PlanePoint> kept;
+      for (PlanePoint& c : t.candidates) {
+        Eigen::Vector2d found;
+        if (!filter->PredictPlanePoint(camera, id, c.ray, &pixel, &jacobian) || !Inside(pixel) ||
+            !Find(grey, keyframe.grey, h, pixel, jacobian, &found) || (found - pixel).norm() > o.candidate_tolerance) {
+          continue;  // inconsistent with the plane (or out of view): pruned
+        }
+        if (++c.count >= o.candidate_frames) {
+          t.members.push_back({c.keyframe_pixel, c.ray, 0});
+        } else {
+          kept.push_back(c);
+        }
+      }
+      t.candidates = std::move(kept);
+      int added = 0;
+      for (Corner& corner : keyframe.corners) {
+        if (added >= o.new_plane_points) break;
+        if (corner.used) continue;
+        auto near = [&](const PlanePoint& m) { return (m.keyframe_pixel - corner.pixel).norm(); };
+        double nearest = 1e9, closest = 1e9;
+        for (const PlanePoint& m : t.members) nearest = std::min(nearest, near(m));
+        for (const PlanePoint& m : t.candidates) closest = std::min(closest, near(m));
+        if (nearest > o.grow_radius || std::min(nearest, closest) < o.min_distance) continue;
+        const Eigen::Vector3d ray = camera.Ray(corner.pixel);
+        if (plane.plane.InverseDepthAlong(ray) <= 0) continue;
+        corner.used = true;
+        t.candidates.push_back({corner.pixel, ray, 0});
+        ++added;
+      }
+      Record(id, t);
+      if (t.age >= o.plane_grow_frames && static_cast<int>(t.members.size()) < o.min_plane_points) {
+        to_points.push_back(id);
+      }
+    }
+    for (int id : empty) RemovePlane(id);
+    for (int id : to_points) {
+      const PlanePoint seed = plane_tracks.at(id).members.front();
+      plane_tracks.erase(id);
+      point_tracks[filter->PlaneToPoint(id, seed.ray)] = {seed.keyframe_pixel, 0};
+      records.erase(id);
+    }
+  }
+
+  FrameStats Track(const cv::Mat& grey, double timestamp) {
+    FrameStats stats;
+    stats.timestamp = timestamp;
+    if (!started) {
+      size = grey.size();
+      Start(grey, CameraState());
+      started = true;
+      stats.keyframe = true;
+    } else {
+      PDVO_THROW_CHECK(grey.size() == size, InvalidArgument, "odometry: frames changed size");
+      PDVO_THROW_CHECK(timestamp > last_time, InvalidArgument,
+                       "odometry: timestamps must increase (" << last_time << " then " << timestamp << ")");
+      filter->Predict(timestamp - last_time, {o.linear_acceleration, o.angular_acceleration});
+      Measure(grey, &stats);
+      if (!filter->covariance().allFinite() || !filter->camera().position.allFinite() ||
+          frames_without_measurements >= o.lost_after) {
+        stats.lost = true;
+        CameraState at = filter->camera();
+        if (!at.position.allFinite() || !at.orientation.coeffs().allFinite()) at = CameraState();
+        for (const auto& [id, t] : plane_tracks) Record(id, t);
+        Start(grey, at);
+        stats.keyframe = true;
+      } else if (static_cast<int>(VisibleFeatures().size()) < o.min_features) {
+        stats.keyframe = MakeKeyframe(grey);
+      }
+    }
+    last_time = timestamp;
+    stats.points = static_cast<int>(filter->points().size());
+    stats.planes = static_cast<int>(filter->planes().size());
+    for (const auto& [id, t] : plane_tracks) stats.plane_points += static_cast<int>(t.members.size());
+    stats.state_size = filter->size();
+    return stats;
   }
 };
 
@@ -286,7 +482,24 @@ FrameStats Odometry::Track(const cv::Mat& grey, double timestamp) {
   return stats;
 }
 
-Rigid3d Odometry::world_from_cam() const { return impl_->filter->camera().world_from_cam(); }
+Rigid3d Odometry::world_from_cam() const {
+  PDVO_THROW_CHECK(impl_->started, InvalidArgument, "odometry: no frame tracked yet");
+  return impl_->filter->camera().world_from_cam();
+}
+
+MappingStats Odometry::mapping() const {
+  MappingStats m;
+  for (const auto& [id, r] : impl_->records) {
+    ++m.planes;
+    m.points_per_plane += r.points;
+    m.mean_plane_area += r.area;
+  }
+  if (m.planes > 0) {
+    m.points_per_plane /= m.planes;
+    m.mean_plane_area /= m.planes;
+  }
+  return m;
+}
 
 const Filter& Odometry::filter() const { return *impl_->filter; }
 

@@ -5,12 +5,17 @@
 // keyframe is made and new points are initialised at its strongest corners. If tracking fails (no measurement
 // for several frames, or a non-finite state) it says so in the statistics and starts again from the last pose.
 //
-// This version maps points only; planar features (idpp.h) are the next step.
+// Planes (mode idpp): at each keyframe, where corners are densest, planes are seeded at a corner, facing the
+// camera; each frame every plane takes up to 3 candidate points from its keyframe's corners near its members
+// (at least 12 px apart); a candidate found within 2 px of where the plane predicts it for 3 frames joins; a plane that has not
+// reached 4 points after 10 frames becomes a point; planes that leave the view leave the filter and are kept
+// in the record (MappingStats).
 #pragma once
 
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "pdvo/common/options.h"
 #include "pdvo/vo/filter.h"
@@ -18,6 +23,7 @@
 namespace pdvo::vo {
 
 struct VoOptions {
+  std::string mode = "idpp";        // idpp: points and planes; points: points only
   int working_width = 320;          // px; frames are resized to this width
   int patch_half = 5;               // patches are (2 half + 1)^2 px
   double search_sigmas = 3;         // search inside this Mahalanobis radius of the prediction
@@ -43,9 +49,19 @@ struct VoOptions {
   double linear_acceleration = 0.5;          // m/s^2, process noise
   double angular_acceleration = 4.0;         // rad/s^2
   int lost_after = 5;               // frames without any measurement before starting again
+  // Planes (mode idpp).
+  int max_new_planes = 3;           // seeded per keyframe
+  double grow_radius = 40;          // px in the keyframe: candidates this near a member; seeds twice apart
+  int new_plane_points = 3;         // candidates a plane takes per frame
+  int candidate_frames = 3;         // consistent matches before a candidate joins
+  double candidate_tolerance = 2.0; // px: a consistent match is this near where the plane predicts it
+  int plane_grow_frames = 10;       // a plane with fewer than min_plane_points after this becomes a point
+  int min_plane_points = 4;
+  double plane_sigma_normal = 0.5;  // prior standard deviation of each normal component (unit normal)
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
+    visit("mode", self.mode);
     visit("working_width", self.working_width);
     visit("patch_half", self.patch_half);
     visit("search_sigmas", self.search_sigmas);
@@ -66,6 +82,14 @@ struct VoOptions {
     visit("linear_acceleration", self.linear_acceleration);
     visit("angular_acceleration", self.angular_acceleration);
     visit("lost_after", self.lost_after);
+    visit("max_new_planes", self.max_new_planes);
+    visit("grow_radius", self.grow_radius);
+    visit("new_plane_points", self.new_plane_points);
+    visit("candidate_frames", self.candidate_frames);
+    visit("candidate_tolerance", self.candidate_tolerance);
+    visit("plane_grow_frames", self.plane_grow_frames);
+    visit("min_plane_points", self.min_plane_points);
+    visit("plane_sigma_normal", self.plane_sigma_normal);
   }
   bool Check() const;
   bool operator==(const VoOptions&) const = default;
@@ -78,9 +102,22 @@ struct FrameStats {
   int measurements = 0;     // matched and used in the update
   int points = 0;           // in the filter after the frame
   int planes = 0;
+  int plane_points = 0;     // points held by those planes
   int state_size = 0;
   bool keyframe = false;
   bool lost = false;        // tracking failed at this frame and started again
+};
+
+// A plane as mapped: its most points and the largest area (convex hull of its points, keyframe pixels).
+struct PlaneRecord {
+  int points = 0;
+  double area = 0;
+};
+// The paper's Table I: planes made (that reached min_plane_points), mean points per plane, mean plane area.
+struct MappingStats {
+  int planes = 0;
+  double points_per_plane = 0;
+  double mean_plane_area = 0;  // px^2, working resolution
 };
 
 class Odometry {
@@ -93,6 +130,7 @@ class Odometry {
   FrameStats Track(const cv::Mat& grey, double timestamp);
   Rigid3d world_from_cam() const;
   const Filter& filter() const;
+  MappingStats mapping() const;
 
  private:
   struct Impl;
