@@ -1,7 +1,7 @@
 // The visual odometry on a synthetic street (default 1,000 frames at 320x240, 30 frames/s, seed 1): tracking
 // speed on one thread (frames are rendered first and not timed), ATE after Sim(3) alignment as a share of the
 // path length, keyframes, lost-track events, and the resident memory of tracking (rendered frames excluded).
-// Usage: vo_bench [frames] [seed]
+// Usage: vo_bench [frames] [seed] [mode: points|idpp]
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +25,8 @@ double ResidentMiB() {
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
+  pdvo::vo::VoOptions vo_options;
+  if (argc > 3) vo_options.mode = argv[3];
   pdvo::sim::SynthOptions options;
   const pdvo::Camera camera = options.MakeCamera();
   const double length = options.walk.speed * frames / options.walk.fps;
@@ -42,7 +44,7 @@ int main(int argc, char** argv) {
     }
   }
   const double before = ResidentMiB();
-  pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, pdvo::vo::VoOptions{});
+  pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, vo_options);
   pdvo::Trajectory estimate;
   int keyframes = 0, lost = 0;
   double measurements = 0, peak = before;
@@ -59,13 +61,16 @@ int main(int argc, char** argv) {
   peak = std::max(peak, ResidentMiB());
   const pdvo::AteResult ate = pdvo::ComputeAte(walk, estimate, pdvo::Alignment::kSim3, 1e-3);
   const double path = pdvo::PathLength(walk);
-  std::printf("vo_bench: %d frames 320x240, seed %llu, path %.1f m\n", frames, static_cast<unsigned long long>(seed),
-              path);
+  const pdvo::vo::MappingStats mapping = odometry.mapping();
+  std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,
+              static_cast<unsigned long long>(seed), vo_options.mode.c_str(), path);
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
   std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n",
               ate.translation.rmse, 100 * ate.translation.rmse / path, ate.translation.max);
   std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times\n", measurements / frames, keyframes,
               lost);
+  std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
+              mapping.points_per_plane, mapping.mean_plane_area);
   std::printf("  memory           %.1f MiB resident with the frames, tracking added %.1f MiB (peak %.1f MiB)\n",
               before, peak - before, peak);
   return 0;

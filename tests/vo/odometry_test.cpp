@@ -44,13 +44,15 @@ const Street& TestStreet() {
   return s;
 }
 
-Trajectory RunOdometry(const Street& s, std::vector<FrameStats>* stats) {
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+Trajectory RunOdometry(const Street& s, std::vector<FrameStats>* stats, const VoOptions& options = {},
+                       MappingStats* mapping = nullptr) {
+  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, options);
   Trajectory estimate;
   for (size_t k = 0; k < s.grey.size(); ++k) {
     stats->push_back(odometry.Track(s.grey[k], s.walk[k].timestamp));
     estimate.push_back({s.walk[k].timestamp, odometry.world_from_cam()});
   }
+  if (mapping) *mapping = odometry.mapping();
   return estimate;
 }
 
@@ -72,6 +74,30 @@ TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
   // velocity extrapolation of the first frame would be off by metres. The target of 1% is not met yet.
   EXPECT_LT(ate.translation.rmse, 0.03 * length) << "path " << length << " m";
   RecordProperty("ate_rmse_percent_of_path", std::to_string(100 * ate.translation.rmse / length));
+}
+
+// With planes (mode idpp): planes are made and grow past the minimum, it tracks to the end, within a bound.
+TEST(Odometry, IdppModeGrowsPlanes) {
+  const Street& s = TestStreet();
+  VoOptions options;
+  options.mode = "idpp";
+  std::vector<FrameStats> stats;
+  MappingStats mapping;
+  const Trajectory estimate = RunOdometry(s, &stats, options, &mapping);
+  int with_planes = 0;
+  for (const FrameStats& f : stats) {
+    EXPECT_FALSE(f.lost) << "at " << f.timestamp;
+    with_planes += f.planes > 0;
+  }
+  EXPECT_GT(with_planes, 0);
+  EXPECT_GE(mapping.planes, 1);
+  EXPECT_GE(mapping.points_per_plane, options.min_plane_points);
+  EXPECT_GT(mapping.mean_plane_area, 0);
+  const AteResult ate = ComputeAte(s.walk, estimate, Alignment::kSim3, 1e-3);
+  const double length = PathLength(s.walk);
+  EXPECT_LT(ate.translation.rmse, 0.05 * length) << "path " << length << " m";
+  RecordProperty("idpp_ate_rmse_percent_of_path", std::to_string(100 * ate.translation.rmse / length));
+  RecordProperty("idpp_planes", std::to_string(mapping.planes));
 }
 
 TEST(Odometry, TheSameFramesGiveTheSameTrajectory) {

@@ -22,8 +22,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(ransac_hypotheses >= 1 && ransac_threshold > 0);
   PDVO_CHECK_OPTION(mode == "idpp" || mode == "points");
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
-  PDVO_CHECK_OPTION(candidate_frames >= 1 && candidate_tolerance > 0 && plane_grow_frames >= 1 &&
-                    min_plane_points >= 3);
+  PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
   PDVO_CHECK_OPTION(plane_sigma_normal > 0);
   PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
@@ -58,11 +57,16 @@ struct Odometry::Impl {
   struct PlanePoint {
     Eigen::Vector2d keyframe_pixel;
     Eigen::Vector3d ray;
-    int count = 0;  // members: consecutive misses; candidates: consecutive consistent matches
+    int count = 0;  // consecutive misses
+  };
+  struct Candidate {
+    int point = -1;  // a point of the filter, until the test decides
+    int age = 0;     // frames since it was made
   };
   struct PlaneTrack {
-    std::vector<PlanePoint> members, candidates;  // members[0] is the seed
-    int age = 0;                                  // frames since the plane was made
+    std::vector<PlanePoint> members;  // members[0] is the seed
+    std::vector<Candidate> candidates;
+    int age = 0;                      // frames since the plane was made
   };
   std::map<int, PlaneTrack> plane_tracks;  // by plane id
   std::map<int, PlaneRecord> records;      // every plane that reached min_plane_points, by plane id
@@ -365,18 +369,18 @@ struct Odometry::Impl {
     frames_without_measurements = used == 0 ? frames_without_measurements + 1 : 0;
     stats->measurements = used;
     for (int id : missed_points) RemovePoint(id);
-    if (o.mode == "idpp") GrowPlanes(grey);
+    if (o.mode == "idpp") GrowPlanes();
   }
 
-  // Members missed too often leave their plane; candidates measured consistently with the plane (found within
-  // candidate_tolerance px of where it predicts them) for candidate_frames frames join it, the others are dropped; each plane takes up to
-  // new_plane_points new candidates a frame from its keyframe's corners near its members; a plane that has not
-  // reached min_plane_points after plane_grow_frames becomes a point.
-  void GrowPlanes(const cv::Mat& grey) {
-    const Rigid3d current = filter->camera().world_from_cam();
+  // The 3D consistency test of plane growing: a candidate is an inverse-depth point of its own (prior: where
+  // its ray meets the plane, 100% uncertain), measured like any point; once its inverse depth is known to 25%
+  // (after at least candidate_frames frames) it joins the plane if that agrees with where its ray meets the
+  // plane (within 3 combined standard deviations), otherwise it stays an ordinary point; one not known after
+  // plane_grow_frames stays a point too. Members missed too often leave; each plane takes up to
+  // new_plane_points new candidates a frame from its keyframe's corners near its members (at least
+  // min_distance apart); a plane that has not reached min_plane_points after plane_grow_frames becomes a point.
+  void GrowPlanes() {
     std::vector<int> to_points, empty;
-    Eigen::Vector2d pixel;
-    Eigen::MatrixXd jacobian;
     for (auto& [id, t] : plane_tracks) {
       ++t.age;
       std::erase_if(t.members, [&](const PlanePoint& m) { return m.count > o.max_misses; });
@@ -384,39 +388,30 @@ struct Odometry::Impl {
         empty.push_back(id);
         continue;
       }
-      const Filter::Plane& plane = filter->planes().at(id);
-      Keyframe& keyframe = keyframes.at(plane.reference);
-      const Eigen::Matrix3d h =
-          PlaneHomography(camera, current, filter->references().at(plane.reference).world_from_cam, plane.plane);
-      std::vector<PlanePoint> kept;
-      for (PlanePoint& c : t.candidates) {
-        Eigen::Vector2d found;
-        if (!filter->PredictPlanePoint(camera, id, c.ray, &pixel, &jacobian) || !Inside(pixel) ||
-            !Find(grey, keyframe.grey, h, pixel, jacobian, &found) || (found - pixel).norm() > o.candidate_tolerance) {
-          continue;  // inconsistent with the plane (or out of view): pruned
+      std::vector<Candidate> waiting;
+      for (Candidate& c : t.candidates) {
+        if (!filter->points().count(c.point)) continue;  // left the view or was lost
+        ++c.age;
+        const Filter::Point& p = filter->points().at(c.point);
+        const double variance = filter->covariance()(p.offset, p.offset);
+        const bool known = p.inverse_depth > 0 && std::sqrt(variance) < 0.25 * p.inverse_depth;
+        if (!known || c.age < o.candidate_frames) {
+          if (c.age < o.plane_grow_frames) waiting.push_back(c);
+          continue;  // otherwise it stays an ordinary point
         }
-        if (++c.count >= o.candidate_frames) {
-          t.members.push_back({c.keyframe_pixel, c.ray, 0});
-        } else {
-          kept.push_back(c);
+        const Filter::Plane& plane = filter->planes().at(id);
+        if (p.reference != plane.reference) continue;
+        const double on_plane = plane.plane.InverseDepthAlong(p.ray);
+        const double plane_variance = InverseDepthVariance(plane, p.ray);
+        if (std::abs(p.inverse_depth - on_plane) < 3 * std::sqrt(variance + plane_variance)) {
+          const PlanePoint joined{point_tracks.at(c.point).keyframe_pixel, p.ray, 0};
+          filter->RemovePoint(c.point);
+          point_tracks.erase(c.point);
+          t.members.push_back(joined);
         }
       }
-      t.candidates = std::move(kept);
-      int added = 0;
-      for (Corner& corner : keyframe.corners) {
-        if (added >= o.new_plane_points) break;
-        if (corner.used) continue;
-        auto near = [&](const PlanePoint& m) { return (m.keyframe_pixel - corner.pixel).norm(); };
-        double nearest = 1e9, closest = 1e9;
-        for (const PlanePoint& m : t.members) nearest = std::min(nearest, near(m));
-        for (const PlanePoint& m : t.candidates) closest = std::min(closest, near(m));
-        if (nearest > o.grow_radius || std::min(nearest, closest) < o.min_distance) continue;
-        const Eigen::Vector3d ray = camera.Ray(corner.pixel);
-        if (plane.plane.InverseDepthAlong(ray) <= 0) continue;
-        corner.used = true;
-        t.candidates.push_back({corner.pixel, ray, 0});
-        ++added;
-      }
+      t.candidates = std::move(waiting);
+      AddCandidates(id, &t);
       Record(id, t);
       if (t.age >= o.plane_grow_frames && static_cast<int>(t.members.size()) < o.min_plane_points) {
         to_points.push_back(id);
@@ -428,6 +423,39 @@ struct Odometry::Impl {
       plane_tracks.erase(id);
       point_tracks[filter->PlaneToPoint(id, seed.ray)] = {seed.keyframe_pixel, 0};
       records.erase(id);
+    }
+  }
+
+  // The variance of the inverse depth at which `ray` meets the plane (first order in (n, rho_p)).
+  double InverseDepthVariance(const Filter::Plane& plane, const Eigen::Vector3d& ray) const {
+    const double norm = plane.plane.normal.norm();
+    const Eigen::Vector3d unit = plane.plane.normal / norm;
+    Eigen::RowVector4d j;
+    j << -plane.plane.inverse_distance * ray.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) /
+             norm,
+        -unit.dot(ray);
+    return (j * filter->covariance().block<4, 4>(plane.offset, plane.offset) * j.transpose())(0, 0);
+  }
+
+  void AddCandidates(int id, PlaneTrack* t) {
+    const Filter::Plane& plane = filter->planes().at(id);
+    Keyframe& keyframe = keyframes.at(plane.reference);
+    const double rho_sigma_ratio = o.initial_inverse_depth_sigma / o.initial_inverse_depth;
+    int added = 0;
+    for (Corner& corner : keyframe.corners) {
+      if (added >= o.new_plane_points) break;
+      if (corner.used) continue;
+      double nearest = 1e9;
+      for (const PlanePoint& m : t->members) nearest = std::min(nearest, (m.keyframe_pixel - corner.pixel).norm());
+      if (nearest > o.grow_radius || nearest < o.min_distance) continue;
+      const Eigen::Vector3d ray = camera.Ray(corner.pixel);
+      const double rho = plane.plane.InverseDepthAlong(ray);
+      if (rho <= 0) continue;
+      corner.used = true;
+      const int point = filter->AddPoint(plane.reference, ray, rho, rho_sigma_ratio * rho);
+      point_tracks[point] = {corner.pixel, 0};
+      t->candidates.push_back({point, 0});
+      ++added;
     }
   }
 
