@@ -17,8 +17,8 @@ namespace pdvo::apps {
 int RunVo(int argc, char** argv) {
   CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
                "(the IDPP system; --set mode=points for points only). Frames are undistorted and resized to the working width. "
-               "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals) and vo.yaml "
-               "(the options used) to the output folder.",
+               "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals), map.ply (points, "
+               "planes as polygons, the camera path) and vo.yaml (the options used) to the output folder.",
                "pdvo vo");
   std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", verbosity = "info";
   std::vector<std::string> overrides;
@@ -77,11 +77,15 @@ int RunVo(int argc, char** argv) {
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
                       {"plane_points", s.plane_points},
                       {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost}});
+    progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
+                     std::to_string(s.planes) + " planes");
     progress.Step();
   }
   progress.Finish();
   PDVO_THROW_CHECK(!trajectory.empty(), FormatError, sequence_path << ": no frames");
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
+  const vo::Map map = odometry.map();
+  vo::WritePly(out.path("map.ply"), map, trajectory);
   const double fps = trajectory.size() / std::max(seconds, 1e-9);
   const vo::MappingStats mapping = odometry.mapping();
   const nlohmann::json totals = {{"frames", trajectory.size()},
@@ -91,7 +95,9 @@ int RunVo(int argc, char** argv) {
                                  {"lost", lost},
                                  {"planes", mapping.planes},
                                  {"points_per_plane", mapping.points_per_plane},
-                                 {"mean_plane_area_px", mapping.mean_plane_area}};
+                                 {"mean_plane_area_px", mapping.mean_plane_area},
+                                 {"map_points", map.points.size()},
+                                 {"map_planes", map.planes.size()}};
   WriteFileAtomically(out.path("stats.json"), nlohmann::json({{"totals", totals}, {"frames", frames}}).dump(1) + "\n");
   out.Commit();
   std::printf("%zu frames, tracking %.1f frames/s (one thread), %d keyframes, lost %d times; %d planes, %.1f "

@@ -203,6 +203,7 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   EXPECT_EQ(stats["totals"]["frames"], 20);
   EXPECT_EQ(stats["frames"].size(), 20u);
   EXPECT_TRUE(fs::exists(dir / "out/vo.yaml"));
+  EXPECT_EQ(ReadFile(dir / "out/map.ply").rfind("ply\n", 0), 0u);
 
   const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
   expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"),

@@ -41,12 +41,16 @@ TEST(Progress, CountsStepsAndPrintsPlainLinesWhenNotOnATerminal) {
   testing::internal::CaptureStderr();
   {
     Progress progress("work", 4, 1e9);
-    for (int i = 0; i < 4; ++i) progress.Step();
+    for (int i = 0; i < 4; ++i) {
+      progress.SetNote("state " + std::to_string(10 * i));
+      progress.Step();
+    }
     EXPECT_EQ(progress.done(), 4u);
     EXPECT_GT(progress.Rate(), 0.0);
   }
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("work: 4/4"), std::string::npos) << err;  // the final line, printed once
+  EXPECT_NE(err.find(", state 30,"), std::string::npos) << err;  // with the latest note
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1);
   SetLogLevel(before);
 }

@@ -182,7 +182,40 @@ struct Odometry::Impl {
     return true;
   }
 
+  Map mapped;  // features that left the filter
+
+  // A point's world position if its inverse depth is known to 30%.
+  bool PointInWorld(int id, Eigen::Vector3d* x) const {
+    const Filter::Point& p = filter->points().at(id);
+    const double sigma = std::sqrt(filter->covariance()(p.offset, p.offset));
+    if (p.inverse_depth <= 0 || sigma > 0.3 * p.inverse_depth) return false;
+    *x = filter->references().at(p.reference).world_from_cam * (p.ray / p.inverse_depth);
+    return true;
+  }
+
+  // A plane as the polygon of its members' convex hull (keyframe order), in the world.
+  bool PlaneInWorld(int id, MapPlane* out) const {
+    const PlaneTrack& t = plane_tracks.at(id);
+    if (static_cast<int>(t.members.size()) < o.min_plane_points) return false;
+    const Filter::Plane& plane = filter->planes().at(id);
+    const Rigid3d& ref = filter->references().at(plane.reference).world_from_cam;
+    std::vector<cv::Point2f> pixels;
+    for (const PlanePoint& m : t.members) pixels.emplace_back(m.keyframe_pixel.x(), m.keyframe_pixel.y());
+    std::vector<int> hull;
+    cv::convexHull(pixels, hull);
+    out->polygon.clear();
+    for (int k : hull) {
+      const double rho = plane.plane.InverseDepthAlong(t.members[k].ray);
+      if (rho <= 0) return false;
+      out->polygon.push_back(ref * (t.members[k].ray / rho));
+    }
+    out->normal = ref.rotation * plane.plane.normal.normalized();
+    return true;
+  }
+
   void RemovePoint(int id) {
+    Eigen::Vector3d x;
+    if (PointInWorld(id, &x)) mapped.points.push_back(x);
     const int reference = filter->points().at(id).reference;
     filter->RemovePoint(id);
     point_tracks.erase(id);
@@ -190,6 +223,8 @@ struct Odometry::Impl {
   }
 
   void RemovePlane(int id) {
+    MapPlane plane;
+    if (PlaneInWorld(id, &plane)) mapped.planes.push_back(plane);
     const int reference = filter->planes().at(id).reference;
     filter->RemovePlane(id);
     plane_tracks.erase(id);
@@ -459,6 +494,20 @@ struct Odometry::Impl {
     }
   }
 
+  // The features in the filter now, as map entries.
+  Map CurrentMap() const {
+    Map m;
+    Eigen::Vector3d x;
+    for (const auto& [id, p] : filter->points()) {
+      if (PointInWorld(id, &x)) m.points.push_back(x);
+    }
+    MapPlane plane;
+    for (const auto& [id, t] : plane_tracks) {
+      if (PlaneInWorld(id, &plane)) m.planes.push_back(plane);
+    }
+    return m;
+  }
+
   FrameStats Track(const cv::Mat& grey, double timestamp) {
     FrameStats stats;
     stats.timestamp = timestamp;
@@ -479,6 +528,9 @@ struct Odometry::Impl {
         CameraState at = filter->camera();
         if (!at.position.allFinite() || !at.orientation.coeffs().allFinite()) at = CameraState();
         for (const auto& [id, t] : plane_tracks) Record(id, t);
+        const Map current = CurrentMap();
+        mapped.points.insert(mapped.points.end(), current.points.begin(), current.points.end());
+        mapped.planes.insert(mapped.planes.end(), current.planes.begin(), current.planes.end());
         Start(grey, at);
         stats.keyframe = true;
       } else if (static_cast<int>(VisibleFeatures().size()) < o.min_features) {
@@ -513,6 +565,16 @@ FrameStats Odometry::Track(const cv::Mat& grey, double timestamp) {
 Rigid3d Odometry::world_from_cam() const {
   PDVO_THROW_CHECK(impl_->started, InvalidArgument, "odometry: no frame tracked yet");
   return impl_->filter->camera().world_from_cam();
+}
+
+Map Odometry::map() const {
+  Map m = impl_->mapped;
+  if (impl_->started) {
+    const Map current = impl_->CurrentMap();
+    m.points.insert(m.points.end(), current.points.begin(), current.points.end());
+    m.planes.insert(m.planes.end(), current.planes.begin(), current.planes.end());
+  }
+  return m;
 }
 
 MappingStats Odometry::mapping() const {

@@ -47,6 +47,8 @@ class Progress {
   Progress& operator=(const Progress&) = delete;
 
   void Step(size_t n = 1);
+  // A short status shown after the counts from the next line on (e.g. "state 212").
+  void SetNote(std::string note) { note_ = std::move(note); }
   void Finish();
   size_t done() const { return done_; }
   // Steps per second so far.
@@ -56,6 +58,7 @@ class Progress {
   void Print(bool final_line);
 
   std::string what_;
+  std::string note_;
   size_t total_;
   size_t done_ = 0;
   double plain_interval_s_;

@@ -20,6 +20,7 @@
 
 #include "pdvo/common/options.h"
 #include "pdvo/vo/filter.h"
+#include "pdvo/vo/map.h"
 
 namespace pdvo::vo {
 
@@ -133,6 +134,8 @@ class Odometry {
   Rigid3d world_from_cam() const;
   const Filter& filter() const;
   MappingStats mapping() const;
+  // Points and planes mapped so far: those that left the filter and those in it.
+  Map map() const;
 
  private:
   struct Impl;
