@@ -3,6 +3,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "pdvo/common/dataset.h"
 #include "pdvo/common/errors.h"
@@ -13,6 +14,27 @@
 #include "tool.h"
 
 namespace pdvo::apps {
+namespace {
+
+// The frame with its features: points green, plane points in a colour per plane; hollow where not found.
+cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations,
+                    const vo::FrameStats& s) {
+  cv::Mat out = colour.clone();
+  for (const vo::Observation& o : observations) {
+    const cv::Scalar c = o.plane < 0 ? cv::Scalar(0, 220, 0)
+                                     : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196,
+                                                  60 + (o.plane * 199) % 196);
+    cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.matched ? cv::FILLED : 1,
+               cv::LINE_AA);
+  }
+  char text[128];
+  std::snprintf(text, sizeof(text), "t %.2f  %d/%d matched  %d points  %d planes%s", s.timestamp, s.measurements,
+                s.attempted, s.points, s.planes, s.lost ? "  LOST" : "");
+  cv::putText(out, text, cv::Point(4, 12), cv::FONT_HERSHEY_PLAIN, 0.8, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  return out;
+}
+
+}  // namespace
 
 int RunVo(int argc, char** argv) {
   CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
@@ -23,12 +45,16 @@ int RunVo(int argc, char** argv) {
   std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", verbosity = "info";
   std::vector<std::string> overrides;
   size_t max_frames = 0;
+  bool overlay = false;
   app.add_option("--sequence,-s", sequence_path, "Image folder, video, TUM or KITTI folder, or pdvo synth output")
       ->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML (default: the sequence's own)");
   app.add_option("--out,-o", out_dir, "Output folder")->required();
   app.add_option("--format", format_name, "Trajectory format: tum or kitti")->capture_default_str();
   app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
+  app.add_flag("--overlay", overlay,
+               "Also write overlay.avi: each frame with its features (points green, plane points coloured by "
+               "plane; hollow where not found) and a status line");
   AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "min_ncc=0.85");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
@@ -60,14 +86,20 @@ int RunVo(int argc, char** argv) {
   int lost = 0, keyframes = 0;
   const size_t total = max_frames > 0 ? std::min(max_frames, sequence->size()) : sequence->size();
   Progress progress("vo", total);
+  cv::VideoWriter video;
+  if (overlay) {
+    video.open(out.path("overlay.avi"), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, cv::Size(width, height));
+    PDVO_THROW_CHECK(video.isOpened(), IoError, out.final_path("overlay.avi") << ": cannot open a video writer");
+  }
   Frame frame;
   while ((max_frames == 0 || trajectory.size() < max_frames) && sequence->Next(&frame)) {
     PDVO_THROW_CHECK(frame.image.cols == camera.width && frame.image.rows == camera.height, FormatError,
                      frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
                                       << ", the camera says " << camera.width << "x" << camera.height);
-    cv::Mat grey, small;
-    cv::cvtColor(undistorter.Apply(frame.image), grey, cv::COLOR_BGR2GRAY);
-    cv::resize(grey, small, cv::Size(width, height), 0, 0, width < camera.width ? cv::INTER_AREA : cv::INTER_LINEAR);
+    cv::Mat colour, small;
+    cv::resize(undistorter.Apply(frame.image), colour, cv::Size(width, height), 0, 0,
+               width < camera.width ? cv::INTER_AREA : cv::INTER_LINEAR);
+    cv::cvtColor(colour, small, cv::COLOR_BGR2GRAY);
     const vo::FrameStats s = odometry.Track(small, frame.timestamp);
     seconds += s.seconds;
     lost += s.lost;
@@ -77,11 +109,13 @@ int RunVo(int argc, char** argv) {
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
                       {"plane_points", s.plane_points},
                       {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost}});
+    if (overlay) video.write(DrawOverlay(colour, odometry.observations(), s));
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
                      std::to_string(s.planes) + " planes");
     progress.Step();
   }
   progress.Finish();
+  video.release();
   PDVO_THROW_CHECK(!trajectory.empty(), FormatError, sequence_path << ": no frames");
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const vo::Map map = odometry.map();

@@ -1,12 +1,16 @@
 // The visual odometry on a synthetic street (default 1,000 frames at 320x240, 30 frames/s, seed 1): tracking
 // speed on one thread (frames are rendered first and not timed), ATE after Sim(3) alignment as a share of the
-// path length, keyframes, lost-track events, and the resident memory of tracking (rendered frames excluded).
-// Usage: vo_bench [frames] [seed] [mode: points|idpp]
+// path length, keyframes, lost-track events, the filter's consistency (NEES of the camera orientation, which
+// monocular VO observes without scale, against the ground truth expressed in the first camera's frame), and the
+// resident memory of tracking (rendered frames excluded).
+// Usage: vo_bench [frames] [seed] [mode: points|idpp] [pixel_sigma]
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgproc.hpp>
+
+#include "pdvo/common/geometry.h"
 
 #include "pdvo/eval/trajectory_error.h"
 #include "pdvo/sim/renderer.h"
@@ -27,6 +31,7 @@ int main(int argc, char** argv) {
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   pdvo::vo::VoOptions vo_options;
   if (argc > 3) vo_options.mode = argv[3];
+  if (argc > 4) vo_options.pixel_sigma = std::atof(argv[4]);
   pdvo::sim::SynthOptions options;
   const pdvo::Camera camera = options.MakeCamera();
   const double length = options.walk.speed * frames / options.walk.fps;
@@ -47,7 +52,9 @@ int main(int argc, char** argv) {
   pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, vo_options);
   pdvo::Trajectory estimate;
   int keyframes = 0, lost = 0;
-  double measurements = 0, peak = before;
+  double measurements = 0, peak = before, nees_sum = 0;
+  int nees_frames = 0, nees_inside = 0;
+  const pdvo::Rigid3d first_inverse = walk.front().world_from_cam.Inverse();
   const auto start = std::chrono::steady_clock::now();
   for (size_t k = 0; k < grey.size(); ++k) {
     const pdvo::vo::FrameStats s = odometry.Track(grey[k], walk[k].timestamp);
@@ -55,6 +62,16 @@ int main(int argc, char** argv) {
     lost += s.lost;
     measurements += s.measurements;
     estimate.push_back({walk[k].timestamp, odometry.world_from_cam()});
+    if (!s.lost && k > 0) {
+      // Orientation error on the right, as the filter's error state: R_est Exp(e) = R_true.
+      const Eigen::Quaterniond truth = (first_inverse * walk[k].world_from_cam).rotation;
+      const Eigen::Vector3d e = pdvo::LogSO3(odometry.world_from_cam().rotation.conjugate() * truth);
+      const Eigen::Matrix3d p = odometry.filter().covariance().block<3, 3>(3, 3);
+      const double nees = e.dot(p.ldlt().solve(e));
+      nees_sum += nees;
+      ++nees_frames;
+      nees_inside += nees < 7.815;  // chi-square(3), 95%
+    }
     if (k % 100 == 0) peak = std::max(peak, ResidentMiB());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -67,6 +84,8 @@ int main(int argc, char** argv) {
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
   std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n",
               ate.translation.rmse, 100 * ate.translation.rmse / path, ate.translation.max);
+  std::printf("  NEES orientation mean %.2f (chi-square(3): 3), %.1f%% of frames inside the 95%% bound (7.81)\n",
+              nees_sum / std::max(1, nees_frames), 100.0 * nees_inside / std::max(1, nees_frames));
   std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times\n", measurements / frames, keyframes,
               lost);
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,

@@ -196,7 +196,8 @@ TEST(Cli, SynthWritesASequenceAndRejectsUnknownOptions) {
 TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   test::TempDir dir;
   ASSERT_EQ(Pdvo("synth -o " + (dir / "s") + " -n 20 --seed 4 -v warning", dir).code, 0);
-  const CommandResult ok = Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "out") + " -v warning", dir);
+  const CommandResult ok =
+      Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "out") + " --set mode=idpp --overlay -v warning", dir);
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_EQ(ReadTrajectory(dir / "out/trajectory.txt", TrajectoryFormat::kTum).size(), 20u);
   const nlohmann::json stats = nlohmann::json::parse(ReadFile(dir / "out/stats.json"));
@@ -204,6 +205,7 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   EXPECT_EQ(stats["frames"].size(), 20u);
   EXPECT_TRUE(fs::exists(dir / "out/vo.yaml"));
   EXPECT_EQ(ReadFile(dir / "out/map.ply").rfind("ply\n", 0), 0u);
+  EXPECT_GT(fs::file_size(dir / "out/overlay.avi"), 1000u);
 
   const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
   expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"),

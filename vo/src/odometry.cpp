@@ -183,6 +183,7 @@ struct Odometry::Impl {
   }
 
   Map mapped;  // features that left the filter
+  std::vector<Observation> observations;  // of the last frame
 
   // A point's world position if its inverse depth is known to 30%.
   bool PointInWorld(int id, Eigen::Vector3d* x) const {
@@ -378,9 +379,11 @@ struct Odometry::Impl {
       Eigen::Vector2d found;
       if (Find(grey, keyframes.at(p.reference).grey, h, pixel, jacobian, &found)) {
         measurements.push_back({id, found, o.pixel_sigma, Eigen::Vector3d::Zero()});
+        observations.push_back({found, -1, true});
         point_tracks[id].misses = 0;
-      } else if (++point_tracks[id].misses > o.max_misses) {
-        missed_points.push_back(id);
+      } else {
+        observations.push_back({pixel, -1, false});
+        if (++point_tracks[id].misses > o.max_misses) missed_points.push_back(id);
       }
     }
     for (auto& [id, t] : plane_tracks) {
@@ -394,8 +397,10 @@ struct Odometry::Impl {
         Eigen::Vector2d found;
         if (Find(grey, keyframes.at(plane.reference).grey, h, pixel, jacobian, &found)) {
           measurements.push_back({id, found, o.pixel_sigma, m.ray});
+          observations.push_back({found, id, true});
           m.count = 0;
         } else {
+          observations.push_back({pixel, id, false});
           ++m.count;
         }
       }
@@ -511,6 +516,7 @@ struct Odometry::Impl {
   FrameStats Track(const cv::Mat& grey, double timestamp) {
     FrameStats stats;
     stats.timestamp = timestamp;
+    observations.clear();
     if (!started) {
       size = grey.size();
       Start(grey, CameraState());
@@ -576,6 +582,8 @@ Map Odometry::map() const {
   }
   return m;
 }
+
+const std::vector<Observation>& Odometry::observations() const { return impl_->observations; }
 
 MappingStats Odometry::mapping() const {
   MappingStats m;

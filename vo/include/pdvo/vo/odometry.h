@@ -111,6 +111,13 @@ struct FrameStats {
   bool lost = false;        // tracking failed at this frame and started again
 };
 
+// A feature as the last frame saw it (for drawing): where it was found, or predicted if it was not.
+struct Observation {
+  Eigen::Vector2d pixel;
+  int plane = -1;        // the plane's id, or -1 for a point
+  bool matched = false;
+};
+
 // A plane as mapped: its most points and the largest area (convex hull of its points, keyframe pixels).
 struct PlaneRecord {
   int points = 0;
@@ -136,6 +143,8 @@ class Odometry {
   MappingStats mapping() const;
   // Points and planes mapped so far: those that left the filter and those in it.
   Map map() const;
+  // The features searched for in the last frame.
+  const std::vector<Observation>& observations() const;
 
  private:
   struct Impl;
