@@ -113,12 +113,7 @@ int Filter::PlaneToPoint(int plane_id, const Eigen::Vector3d& ray) {
   const Plane plane = it->second;
   const Eigen::Vector3d m = ray.normalized();
   const double rho = plane.plane.InverseDepthAlong(m);
-  // rho = -rho_p (n^ . m): its Jacobian with respect to (n, rho_p), as in ProjectPlanePoint.
-  const double norm = plane.plane.normal.norm();
-  const Eigen::Vector3d unit = plane.plane.normal / norm;
-  Eigen::RowVector4d j;
-  j << -plane.plane.inverse_distance * m.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm,
-      -unit.dot(m);
+  const Eigen::RowVector4d j = plane.plane.InverseDepthJacobian(m);
   const int n = size();
   const Eigen::RowVectorXd cross = j * covariance_.middleRows<4>(plane.offset);  // with the whole state
   Augment(Eigen::VectorXd::Zero(1));

@@ -20,6 +20,15 @@ double InversePlane::InverseDepthAlong(const Eigen::Vector3d& ray) const {
   return -inverse_distance * normal.normalized().dot(ray);
 }
 
+Eigen::RowVector4d InversePlane::InverseDepthJacobian(const Eigen::Vector3d& ray) const {
+  const double norm = normal.norm();
+  const Eigen::Vector3d unit = normal / norm;
+  Eigen::RowVector4d j;
+  j << -inverse_distance * ray.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm,
+      -unit.dot(ray);
+  return j;
+}
+
 bool ProjectInverseDepth(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                          const Eigen::Vector3d& ray, double rho, Eigen::Vector2d* pixel, ProjectionJacobians* j) {
   const Eigen::Matrix3d rc_t = world_from_current.rotation.toRotationMatrix().transpose();
@@ -44,15 +53,7 @@ bool ProjectPlanePoint(const Pinhole& camera, const Rigid3d& world_from_current,
   const double rho = plane.InverseDepthAlong(ray);
   if (rho <= 0) return false;
   if (!ProjectInverseDepth(camera, world_from_current, world_from_ref, ray, rho, pixel, j)) return false;
-  if (plane_jacobian && j) {
-    // rho = -rho_p (n^ . m), n^ = n / |n|: d n^ / d n = (I - n^ n^T) / |n|.
-    const double norm = plane.normal.norm();
-    const Eigen::Vector3d unit = plane.normal / norm;
-    const Eigen::RowVector3d drho_dn =
-        -plane.inverse_distance * ray.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm;
-    plane_jacobian->leftCols<3>() = j->inverse_depth * drho_dn;
-    plane_jacobian->col(3) = j->inverse_depth * (-unit.dot(ray));
-  }
+  if (plane_jacobian && j) *plane_jacobian = j->inverse_depth * plane.InverseDepthJacobian(ray);
   return true;
 }
 

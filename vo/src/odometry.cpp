@@ -3,8 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
-#include <random>
 #include <cmath>
+#include <random>
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/errors.h"
@@ -70,6 +70,8 @@ struct Odometry::Impl {
   };
   std::map<int, PlaneTrack> plane_tracks;  // by plane id
   std::map<int, PlaneRecord> records;      // every plane that reached min_plane_points, by plane id
+  Map mapped;                              // features that left the filter
+  std::vector<Observation> observations;   // of the last frame
 
   bool Inside(const Eigen::Vector2d& p) const {
     return p.x() >= o.border && p.y() >= o.border && p.x() < size.width - o.border &&
@@ -87,7 +89,8 @@ struct Odometry::Impl {
     rest.angular_velocity.setZero();
     Vector12d sigma;
     sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6),
-        Eigen::Vector3d::Constant(o.initial_velocity_sigma), Eigen::Vector3d::Constant(o.angular_acceleration);
+        Eigen::Vector3d::Constant(o.initial_velocity_sigma),
+        Eigen::Vector3d::Constant(o.angular_acceleration * 1.0);  // rad/s: one second of angular acceleration
     filter = std::make_unique<Filter>(rest, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     keyframes.clear();
     point_tracks.clear();
@@ -96,7 +99,7 @@ struct Odometry::Impl {
     MakeKeyframe(grey);
   }
 
-  // Keyframe pixels of the features measured in the current view, predicted.
+  // The predicted pixels of the features in view (points and plane members).
   std::vector<Eigen::Vector2d> VisibleFeatures() const {
     std::vector<Eigen::Vector2d> out;
     Eigen::Vector2d pixel;
@@ -111,13 +114,17 @@ struct Odometry::Impl {
     return out;
   }
 
-  // Inverse distances from the current camera of the points whose inverse depth is known to 30%, sorted.
+  // A point whose inverse depth is known to 30%.
+  bool Converged(const Filter::Point& p) const {
+    return p.inverse_depth > 0 && std::sqrt(filter->covariance()(p.offset, p.offset)) < 0.3 * p.inverse_depth;
+  }
+
+  // Inverse distances from the current camera of the converged points, sorted.
   std::vector<double> ConvergedInverseDepths() const {
     std::vector<double> out;
     const Rigid3d cam_from_world = filter->camera().world_from_cam().Inverse();
     for (const auto& [id, p] : filter->points()) {
-      const double variance = filter->covariance()(p.offset, p.offset);
-      if (p.inverse_depth <= 0 || std::sqrt(variance) > 0.3 * p.inverse_depth) continue;
+      if (!Converged(p)) continue;
       const Rigid3d& ref = filter->references().at(p.reference).world_from_cam;
       out.push_back(1 / (cam_from_world * (ref * (p.ray / p.inverse_depth))).norm());
     }
@@ -182,14 +189,10 @@ struct Odometry::Impl {
     return true;
   }
 
-  Map mapped;  // features that left the filter
-  std::vector<Observation> observations;  // of the last frame
-
-  // A point's world position if its inverse depth is known to 30%.
+  // A point's world position if it has converged.
   bool PointInWorld(int id, Eigen::Vector3d* x) const {
     const Filter::Point& p = filter->points().at(id);
-    const double sigma = std::sqrt(filter->covariance()(p.offset, p.offset));
-    if (p.inverse_depth <= 0 || sigma > 0.3 * p.inverse_depth) return false;
+    if (!Converged(p)) return false;
     *x = filter->references().at(p.reference).world_from_cam * (p.ray / p.inverse_depth);
     return true;
   }
@@ -200,12 +203,8 @@ struct Odometry::Impl {
     if (static_cast<int>(t.members.size()) < o.min_plane_points) return false;
     const Filter::Plane& plane = filter->planes().at(id);
     const Rigid3d& ref = filter->references().at(plane.reference).world_from_cam;
-    std::vector<cv::Point2f> pixels;
-    for (const PlanePoint& m : t.members) pixels.emplace_back(m.keyframe_pixel.x(), m.keyframe_pixel.y());
-    std::vector<int> hull;
-    cv::convexHull(pixels, hull);
     out->polygon.clear();
-    for (int k : hull) {
+    for (int k : Hull(t.members)) {
       const double rho = plane.plane.InverseDepthAlong(t.members[k].ray);
       if (rho <= 0) return false;
       out->polygon.push_back(ref * (t.members[k].ray / rho));
@@ -232,13 +231,20 @@ struct Odometry::Impl {
     if (!filter->references().count(reference)) keyframes.erase(reference);
   }
 
+  // The members on the convex hull of their keyframe pixels, in order around it.
+  static std::vector<int> Hull(const std::vector<PlanePoint>& members) {
+    std::vector<cv::Point2f> pixels;
+    for (const PlanePoint& m : members) pixels.emplace_back(m.keyframe_pixel.x(), m.keyframe_pixel.y());
+    std::vector<int> hull;
+    if (!pixels.empty()) cv::convexHull(pixels, hull);
+    return hull;
+  }
+
   // The area (keyframe pixels) of the convex hull of a plane's members.
   static double Area(const PlaneTrack& t) {
-    if (t.members.size() < 3) return 0;
-    std::vector<cv::Point2f> pixels, hull;
-    for (const PlanePoint& m : t.members) pixels.emplace_back(m.keyframe_pixel.x(), m.keyframe_pixel.y());
-    cv::convexHull(pixels, hull);
-    return cv::contourArea(hull);
+    std::vector<cv::Point2f> corners;
+    for (int k : Hull(t.members)) corners.emplace_back(t.members[k].keyframe_pixel.x(), t.members[k].keyframe_pixel.y());
+    return corners.size() < 3 ? 0.0 : cv::contourArea(corners);
   }
 
   void Record(int id, const PlaneTrack& t) {
@@ -248,7 +254,7 @@ struct Odometry::Impl {
     r.area = std::max(r.area, Area(t));
   }
 
-    // NCC search for `templ` (CV_32F) in `grey` within the ellipse of S around `predicted`.
+  // NCC search for `templ` (CV_32F) in `grey` within the ellipse of S around `predicted`.
   bool Search(const cv::Mat& grey, const cv::Mat& templ, const Eigen::Vector2d& predicted, const Eigen::Matrix2d& s,
               Eigen::Vector2d* found) const {
     const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff();
@@ -468,12 +474,7 @@ struct Odometry::Impl {
 
   // The variance of the inverse depth at which `ray` meets the plane (first order in (n, rho_p)).
   double InverseDepthVariance(const Filter::Plane& plane, const Eigen::Vector3d& ray) const {
-    const double norm = plane.plane.normal.norm();
-    const Eigen::Vector3d unit = plane.plane.normal / norm;
-    Eigen::RowVector4d j;
-    j << -plane.plane.inverse_distance * ray.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) /
-             norm,
-        -unit.dot(ray);
+    const Eigen::RowVector4d j = plane.plane.InverseDepthJacobian(ray);
     return (j * filter->covariance().block<4, 4>(plane.offset, plane.offset) * j.transpose())(0, 0);
   }
 

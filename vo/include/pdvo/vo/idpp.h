@@ -32,6 +32,8 @@ struct InversePlane {
   double inverse_distance = 0;
   // The inverse depth at which the ray m (unit, reference frame) meets the plane; <= 0 if it does not in front.
   double InverseDepthAlong(const Eigen::Vector3d& ray) const;
+  // Its derivative with respect to (n, rho_p): rho = -rho_p (n^ . m) with d n^ / d n = (I - n^ n^T) / |n|.
+  Eigen::RowVector4d InverseDepthJacobian(const Eigen::Vector3d& ray) const;
 };
 
 // Jacobians of a projected pixel.

@@ -51,7 +51,7 @@ struct VoOptions {
   // measurements): the velocity prior is tight and the acceleration noise lets it grow.
   double initial_velocity_sigma = 0.1;       // m/s
   double linear_acceleration = 0.5;          // m/s^2, process noise
-  double angular_acceleration = 4.0;         // rad/s^2
+  double angular_acceleration = 4.0;         // rad/s^2; a second of it is the starting angular velocity sigma
   int lost_after = 5;               // frames without any measurement before starting again
   // Planes (mode idpp).
   int max_new_planes = 3;           // seeded per keyframe
