@@ -38,11 +38,11 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
 
 int RunVo(int argc, char** argv) {
   CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
-               "(the IDPP system; --set mode=points for points only). Frames are undistorted and resized to the working width. "
+               "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to the working width. "
                "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals), map.ply (points, "
                "planes as polygons, the camera path) and vo.yaml (the options used) to the output folder.",
                "pdvo vo");
-  std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", verbosity = "info";
+  std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", mode, verbosity = "info";
   std::vector<std::string> overrides;
   size_t max_frames = 0;
   bool overlay = false;
@@ -50,6 +50,7 @@ int RunVo(int argc, char** argv) {
       ->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML (default: the sequence's own)");
   app.add_option("--out,-o", out_dir, "Output folder")->required();
+  app.add_option("--mode", mode, "idpp (points and planes) or points (default: the options' mode, points)");
   app.add_option("--format", format_name, "Trajectory format: tum or kitti")->capture_default_str();
   app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
   app.add_flag("--overlay", overlay,
@@ -60,6 +61,7 @@ int RunVo(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
+  if (!mode.empty()) overrides.push_back("mode=" + mode);
   const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
   const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
   std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);

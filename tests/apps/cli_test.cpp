@@ -197,7 +197,7 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   test::TempDir dir;
   ASSERT_EQ(Pdvo("synth -o " + (dir / "s") + " -n 20 --seed 4 -v warning", dir).code, 0);
   const CommandResult ok =
-      Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "out") + " --set mode=idpp --overlay -v warning", dir);
+      Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "out") + " --mode idpp --overlay -v warning", dir);
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_EQ(ReadTrajectory(dir / "out/trajectory.txt", TrajectoryFormat::kTum).size(), 20u);
   const nlohmann::json stats = nlohmann::json::parse(ReadFile(dir / "out/stats.json"));

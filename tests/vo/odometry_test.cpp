@@ -111,6 +111,28 @@ TEST(Odometry, TheSameFramesGiveTheSameTrajectory) {
   }
 }
 
+// Ten blank frames in the middle (a covered lens): tracking fails, says so, starts again, and goes on to the end
+// with a finite pose.
+TEST(Odometry, SaysWhenItIsLostAndStartsAgain) {
+  const Street& s = TestStreet();
+  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  const cv::Mat blank(s.grey[0].size(), CV_8U, cv::Scalar(90));
+  int lost = 0, lost_at = -1;
+  for (size_t k = 0; k < s.grey.size(); ++k) {
+    const bool covered = k >= 60 && k < 70;
+    const FrameStats f = odometry.Track(covered ? blank : s.grey[k], s.walk[k].timestamp);
+    if (f.lost && lost_at < 0) lost_at = static_cast<int>(k);
+    lost += f.lost;
+    EXPECT_TRUE(odometry.world_from_cam().translation.allFinite()) << k;
+    if (k > 80) {
+      EXPECT_GT(f.measurements, 0) << "tracking again at " << k;
+    }
+  }
+  EXPECT_GE(lost, 1);
+  EXPECT_GE(lost_at, 60);
+  EXPECT_LT(lost_at, 70);
+}
+
 TEST(Odometry, RefusesBadFrames) {
   const Street& s = TestStreet();
   Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
