@@ -38,8 +38,8 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
 
 int RunVo(int argc, char** argv) {
   CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
-               "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to the working width. "
-               "Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals), map.ply (points, "
+               "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to "
+               "the working width. Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals), map.ply (points, "
                "planes as polygons, the camera path) and vo.yaml (the options used) to the output folder.",
                "pdvo vo");
   std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", mode, verbosity = "info";
