@@ -39,14 +39,7 @@ int RunAnnotateDepth(int argc, char** argv) {
   const auto options = LoadToolOptions<DepthPlaneOptions>(config_path, "annotate_depth", overrides);
 
   std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
-  Camera camera;
-  if (!camera_path.empty()) {
-    camera = Camera::Read(camera_path);
-  } else {
-    PDVO_THROW_CHECK(sequence->camera().has_value(), InvalidArgument,
-                     sequence_path << ": holds no camera.yaml; pass --camera");
-    camera = *sequence->camera();
-  }
+  const Camera camera = SequenceCamera(*sequence, sequence_path, camera_path);
   const DepthPlaneFinder finder(camera, options);
   PDVO_LOG(Info) << "annotating " << sequence->Describe() << " at " << finder.working_size().width << "x"
                  << finder.working_size().height;

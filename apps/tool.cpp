@@ -2,6 +2,7 @@
 
 #include <opencv2/core/utils/logger.hpp>
 
+#include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
 
 namespace pdvo::apps {
@@ -23,6 +24,13 @@ void ApplyVerbosity(const std::string& verbosity) {
   // OpenCV's own messages would break the one-line errors; they are shown only when debugging.
   cv::utils::logging::setLogLevel(level == LogLevel::kDebug ? cv::utils::logging::LOG_LEVEL_WARNING
                                                            : cv::utils::logging::LOG_LEVEL_SILENT);
+}
+
+Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path, const std::string& camera_path) {
+  if (!camera_path.empty()) return Camera::Read(camera_path);
+  PDVO_THROW_CHECK(sequence.camera().has_value(), InvalidArgument,
+                   sequence_path << ": holds no camera.yaml; pass --camera");
+  return *sequence.camera();
 }
 
 }  // namespace pdvo::apps

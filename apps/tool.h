@@ -4,9 +4,12 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "pdvo/common/options.h"
 #include <string>
 #include <vector>
+
+#include "pdvo/common/camera.h"
+#include "pdvo/common/dataset.h"
+#include "pdvo/common/options.h"
 
 namespace pdvo::apps {
 
@@ -42,6 +45,10 @@ Options LoadToolOptions(const std::string& config_path, const std::string& secti
   CheckOptionsOrThrow(options, section + " options");
   return options;
 }
+
+// The camera of a sequence: from `camera_path` if given, else the sequence's own; throws naming the file, or
+// the sequence that holds none.
+Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path, const std::string& camera_path);
 
 // Every .json file among the given files and folders (folders not recursed), sorted; throws IoError for a
 // missing path and FormatError for a folder without annotations.

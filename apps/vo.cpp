@@ -65,14 +65,7 @@ int RunVo(int argc, char** argv) {
   const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
   const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
   std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
-  Camera camera;
-  if (!camera_path.empty()) {
-    camera = Camera::Read(camera_path);
-  } else {
-    PDVO_THROW_CHECK(sequence->camera().has_value(), InvalidArgument,
-                     sequence_path << ": holds no camera; pass --camera");
-    camera = *sequence->camera();
-  }
+  const Camera camera = SequenceCamera(*sequence, sequence_path, camera_path);
   const Undistorter undistorter(camera);
   const int width = options.working_width > 0 ? options.working_width : camera.width;
   const int height = static_cast<int>(std::lround(camera.height * static_cast<double>(width) / camera.width));
