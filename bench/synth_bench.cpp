@@ -5,21 +5,13 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <string>
 
+#include "memory.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
 
-namespace {
-// Resident memory now, in MiB (from /proc/self/statm).
-double ResidentMiB() {
-  std::ifstream statm("/proc/self/statm");
-  long pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return resident * 4096.0 / (1 << 20);
-}
-}  // namespace
+using pdvo::bench::ResidentMiB;
 
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 2000;

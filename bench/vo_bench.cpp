@@ -7,24 +7,17 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/geometry.h"
 
 #include "pdvo/eval/trajectory_error.h"
+#include "memory.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
 #include "pdvo/vo/odometry.h"
 
-namespace {
-double ResidentMiB() {
-  std::ifstream statm("/proc/self/statm");
-  long pages = 0, resident = 0;
-  statm >> pages >> resident;
-  return resident * 4096.0 / (1 << 20);
-}
-}  // namespace
+using pdvo::bench::ResidentMiB;
 
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;

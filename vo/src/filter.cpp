@@ -182,6 +182,12 @@ bool Filter::PredictPlanePoint(const Pinhole& camera, int id, const Eigen::Vecto
   return true;
 }
 
+bool Filter::PredictMeasurement(const Pinhole& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
+                                Eigen::MatrixXd* jacobian) const {
+  return planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
+                                : PredictPoint(camera, z.point, pixel, jacobian);
+}
+
 double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements) {
   if (measurements.empty()) return 0;
   const int m = 2 * static_cast<int>(measurements.size()), n = size();
@@ -191,8 +197,7 @@ double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>
     Eigen::Vector2d predicted;
     Eigen::MatrixXd jk;
     const PointMeasurement& z = measurements[k];
-    const bool in_front = planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, &predicted, &jk)
-                                                 : PredictPoint(camera, z.point, &predicted, &jk);
+    const bool in_front = PredictMeasurement(camera, z, &predicted, &jk);
     PDVO_THROW_CHECK(in_front, InvalidArgument, "filter: feature " << z.point << " is not in front of the camera");
     h.middleRows<2>(2 * k) = jk;
     innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;

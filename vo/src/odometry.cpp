@@ -78,11 +78,6 @@ struct Odometry::Impl {
            p.y() < size.height - o.border;
   }
 
-  bool Predict(const Filter& f, const PointMeasurement& z, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
-    return f.planes().count(z.point) ? f.PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
-                                     : f.PredictPoint(camera, z.point, pixel, jacobian);
-  }
-
   void Start(const cv::Mat& grey, const CameraState& at) {
     CameraState rest = at;
     rest.velocity.setZero();
@@ -309,7 +304,7 @@ struct Odometry::Impl {
       std::vector<PointMeasurement> in;
       for (const PointMeasurement& z : all) {
         Eigen::Vector2d predicted;
-        if (Predict(f, z, &predicted, nullptr) && (predicted - z.pixel).norm() < threshold) {
+        if (f.PredictMeasurement(camera, z, &predicted, nullptr) && (predicted - z.pixel).norm() < threshold) {
           in.push_back(z);
         }
       }
@@ -332,7 +327,7 @@ struct Odometry::Impl {
       if (std::any_of(best.begin(), best.end(), [&](const PointMeasurement& b) { return b.point == z.point; })) continue;
       Eigen::Vector2d predicted;
       Eigen::MatrixXd jacobian;
-      if (!Predict(*filter, z, &predicted, &jacobian)) continue;
+      if (!filter->PredictMeasurement(camera, z, &predicted, &jacobian)) continue;
       Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
       s.diagonal().array() += z.sigma * z.sigma;
       const Eigen::Vector2d v = z.pixel - predicted;

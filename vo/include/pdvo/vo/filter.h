@@ -81,6 +81,10 @@ class Filter {
   bool PredictPlanePoint(const Pinhole& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                          Eigen::MatrixXd* jacobian) const;
 
+  // The predicted pixel of a measurement's feature (a point, or the plane point on its ray), as above.
+  bool PredictMeasurement(const Pinhole& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
+                          Eigen::MatrixXd* jacobian) const;
+
   // One batched EKF update with the measurements (points must exist and be in front of the camera); returns
   // the normalised innovation squared of the batch (chi-square with 2 x count degrees of freedom).
   double Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements);
