@@ -16,15 +16,17 @@
 namespace pdvo::apps {
 namespace {
 
-// The frame with its features: points green, plane points in a colour per plane; hollow where not found.
+// The frame with its features: points green, plane points in a colour per plane; filled where the update used
+// the match, hollow where the search failed, red where RANSAC rejected the match.
 cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations,
                     const vo::FrameStats& s) {
   cv::Mat out = colour.clone();
   for (const vo::Observation& o : observations) {
-    const cv::Scalar c = o.plane < 0 ? cv::Scalar(0, 220, 0)
-                                     : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196,
-                                                  60 + (o.plane * 199) % 196);
-    cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.matched ? cv::FILLED : 1,
+    const cv::Scalar c = o.matched && !o.used ? cv::Scalar(0, 0, 255)
+                         : o.plane < 0        ? cv::Scalar(0, 220, 0)
+                                              : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196,
+                                                           60 + (o.plane * 199) % 196);
+    cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.used ? cv::FILLED : 1,
                cv::LINE_AA);
   }
   char text[128];

@@ -3,13 +3,14 @@
 // path length, keyframes, lost-track events, the filter's consistency (NEES of the camera orientation, which
 // monocular VO observes without scale, against the ground truth expressed in the first camera's frame), and the
 // resident memory of tracking (rendered frames excluded).
-// Usage: vo_bench [frames] [seed] [mode: points|idpp] [pixel_sigma]
+// Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp pixel_sigma=0.5)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/geometry.h"
+#include "pdvo/common/options.h"
 
 #include "pdvo/eval/trajectory_error.h"
 #include "memory.h"
@@ -23,8 +24,20 @@ int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   pdvo::vo::VoOptions vo_options;
-  if (argc > 3) vo_options.mode = argv[3];
-  if (argc > 4) vo_options.pixel_sigma = std::atof(argv[4]);
+  for (int i = 3; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const size_t eq = arg.find('=');
+    if (eq == std::string::npos) {
+      std::fprintf(stderr, "vo_bench: expected option=value, got '%s'\n", argv[i]);
+      return 2;
+    }
+    try {
+      pdvo::SetOption(vo_options, arg.substr(0, eq), arg.substr(eq + 1));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vo_bench: %s\n", e.what());
+      return 2;
+    }
+  }
   pdvo::sim::SynthOptions options;
   const pdvo::Camera camera = options.MakeCamera();
   const double length = options.walk.speed * frames / options.walk.fps;

@@ -18,7 +18,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(search_sigmas > 0 && max_search_radius >= 1);
   PDVO_CHECK_OPTION(min_ncc > -1 && min_ncc < 1 && pixel_sigma > 0);
   PDVO_CHECK_OPTION(max_measurements >= 1 && min_features >= 1 && new_features >= 1 && min_distance >= 1);
-  PDVO_CHECK_OPTION(max_misses >= 1 && lost_after >= 1);
+  PDVO_CHECK_OPTION(max_misses >= 1 && lost_after >= 1 && min_rejections >= 1 && max_rejected_share >= 0);
   PDVO_CHECK_OPTION(ransac_hypotheses >= 1 && ransac_threshold > 0);
   PDVO_CHECK_OPTION(mode == "idpp" || mode == "points");
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
@@ -37,6 +37,7 @@ struct Odometry::Impl {
   std::mt19937 rng{1};  // RANSAC; fixed seed: the same frames give the same trajectory
   double last_time = 0;
   bool started = false;
+  double now = 0;
   int frames_without_measurements = 0;
 
   // Per reference camera: its keyframe image and the corners found in it (planes grow over these).
@@ -46,18 +47,26 @@ struct Odometry::Impl {
   };
   struct Keyframe {
     cv::Mat grey;
+    double time = 0;
     std::vector<Corner> corners;
   };
   std::map<int, Keyframe> keyframes;
+  // How a feature has fared: a feature leaves after more than max_misses failed searches in a row, or when
+  // RANSAC has rejected too many of its matches (the patch straddles a depth edge or slides on a repetition).
+  struct History {
+    int misses = 0;    // consecutive failed searches
+    int matched = 0;   // searches that found a match
+    int rejected = 0;  // matches that RANSAC and its rescue rejected
+  };
   struct PointTrack {
     Eigen::Vector2d keyframe_pixel;
-    int misses = 0;
+    History history;
   };
   std::map<int, PointTrack> point_tracks;  // by point id
   struct PlanePoint {
     Eigen::Vector2d keyframe_pixel;
     Eigen::Vector3d ray;
-    int count = 0;  // consecutive misses
+    History history;
   };
   struct Candidate {
     int point = -1;  // a point of the filter, until the test decides
@@ -92,6 +101,10 @@ struct Odometry::Impl {
     plane_tracks.clear();
     frames_without_measurements = 0;
     MakeKeyframe(grey);
+  }
+
+  bool Gone(const History& r) const {
+    return r.misses > o.max_misses || (r.rejected >= o.min_rejections && r.rejected > o.max_rejected_share * r.matched);
   }
 
   // The predicted pixels of the features in view (points and plane members).
@@ -148,6 +161,7 @@ struct Odometry::Impl {
     const int reference = filter->AddReference();
     Keyframe& keyframe = keyframes[reference];
     keyframe.grey = grey.clone();
+    keyframe.time = now;
     for (const cv::Point2f& c : found) keyframe.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
     std::vector<Corner>& corners = keyframe.corners;
     std::vector<int> seeds;
@@ -171,7 +185,7 @@ struct Odometry::Impl {
       corners[i].used = true;
       const Eigen::Vector3d ray = camera.Ray(corners[i].pixel);
       const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, sigma);
-      plane_tracks[id].members.push_back({corners[i].pixel, ray, 0});
+      plane_tracks[id].members.push_back({corners[i].pixel, ray, {}});
     }
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
     int points = 0;
@@ -179,7 +193,7 @@ struct Odometry::Impl {
       if (c.used || points + static_cast<int>(seeds.size()) >= o.new_features) continue;
       c.used = true;
       ++points;
-      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma)] = {c.pixel, 0};
+      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma)] = {c.pixel, {}};
     }
     return true;
   }
@@ -297,44 +311,58 @@ struct Odometry::Impl {
   // 1-point RANSAC (Civera et al. 2010): each hypothesis is the state after an update with one measurement;
   // the one that brings most other measurements within `ransac_threshold` px gives the inliers, which update
   // the filter; then any other measurement whose innovation is now within the 99% gate updates it too.
-  // Returns the number of measurements used.
-  int UpdateRobustly(const std::vector<PointMeasurement>& all) {
-    if (all.empty()) return 0;
-    auto agreeing = [&](const Filter& f, double threshold) {
-      std::vector<PointMeasurement> in;
-      for (const PointMeasurement& z : all) {
+  // Returns, per measurement, whether it was used.
+  std::vector<bool> UpdateRobustly(const std::vector<PointMeasurement>& all) {
+    std::vector<bool> used(all.size(), false);
+    if (all.empty()) return used;
+    auto agreeing = [&](const Filter& f) {
+      std::vector<bool> in(all.size(), false);
+      for (size_t i = 0; i < all.size(); ++i) {
         Eigen::Vector2d predicted;
-        if (f.PredictMeasurement(camera, z, &predicted, nullptr) && (predicted - z.pixel).norm() < threshold) {
-          in.push_back(z);
-        }
+        in[i] = f.PredictMeasurement(camera, all[i], &predicted, nullptr) &&
+                (predicted - all[i].pixel).norm() < o.ransac_threshold;
       }
       return in;
     };
-    std::vector<PointMeasurement> best;
     const int hypotheses = std::min<int>(o.ransac_hypotheses, static_cast<int>(all.size()));
     std::uniform_int_distribution<size_t> pick(0, all.size() - 1);
+    long most = 0;
     for (int k = 0; k < hypotheses; ++k) {
       Filter hypothesis = *filter;
       hypothesis.Update(camera, {all[pick(rng)]});
-      std::vector<PointMeasurement> in = agreeing(hypothesis, o.ransac_threshold);
-      if (in.size() > best.size()) best = std::move(in);
+      std::vector<bool> in = agreeing(hypothesis);
+      const long count = std::count(in.begin(), in.end(), true);
+      if (count > most) {
+        most = count;
+        used = std::move(in);
+      }
     }
-    if (best.empty()) return 0;
-    filter->Update(camera, best);
+    if (most == 0) return used;
+    filter->Update(camera, Select(all, used, true));
     // Rescue: the rest, gated on their innovation after the inliers' update.
-    std::vector<PointMeasurement> rescued;
-    for (const PointMeasurement& z : all) {
-      if (std::any_of(best.begin(), best.end(), [&](const PointMeasurement& b) { return b.point == z.point; })) continue;
+    std::vector<bool> rescued(all.size(), false);
+    for (size_t i = 0; i < all.size(); ++i) {
       Eigen::Vector2d predicted;
       Eigen::MatrixXd jacobian;
-      if (!filter->PredictMeasurement(camera, z, &predicted, &jacobian)) continue;
+      if (used[i] || !filter->PredictMeasurement(camera, all[i], &predicted, &jacobian)) continue;
       Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
-      s.diagonal().array() += z.sigma * z.sigma;
-      const Eigen::Vector2d v = z.pixel - predicted;
-      if (v.dot(s.ldlt().solve(v)) < 9.21) rescued.push_back(z);  // chi-square(2), 99%
+      s.diagonal().array() += all[i].sigma * all[i].sigma;
+      const Eigen::Vector2d v = all[i].pixel - predicted;
+      rescued[i] = v.dot(s.ldlt().solve(v)) < 9.21;  // chi-square(2), 99%
     }
-    if (!rescued.empty()) filter->Update(camera, rescued);
-    return static_cast<int>(best.size() + rescued.size());
+    const std::vector<PointMeasurement> more = Select(all, rescued, true);
+    if (!more.empty()) filter->Update(camera, more);
+    for (size_t i = 0; i < all.size(); ++i) used[i] = used[i] || rescued[i];
+    return used;
+  }
+
+  static std::vector<PointMeasurement> Select(const std::vector<PointMeasurement>& all, const std::vector<bool>& flags,
+                                              bool value) {
+    std::vector<PointMeasurement> out;
+    for (size_t i = 0; i < all.size(); ++i) {
+      if (flags[i] == value) out.push_back(all[i]);
+    }
+    return out;
   }
 
   // Searches for a feature whose pixel is predicted with `jacobian`, warping its keyframe patch by `h`.
@@ -369,7 +397,7 @@ struct Odometry::Impl {
     }
 
     std::vector<PointMeasurement> measurements;
-    std::vector<int> missed_points;
+    std::vector<std::pair<History*, size_t>> searched;  // per measurement: its feature's history, observation
     Eigen::MatrixXd jacobian;
     for (const auto& [id, p] : filter->points()) {
       if (stats->attempted >= o.max_measurements) break;
@@ -378,13 +406,15 @@ struct Odometry::Impl {
       const Eigen::Matrix3d h = PlaneHomography(camera, current, filter->references().at(p.reference).world_from_cam,
                                                 FrontoParallel(p.ray, std::max(p.inverse_depth, 1e-3)));
       Eigen::Vector2d found;
+      PointTrack& track = point_tracks.at(id);
       if (Find(grey, keyframes.at(p.reference).grey, h, pixel, jacobian, &found)) {
         measurements.push_back({id, found, o.pixel_sigma, Eigen::Vector3d::Zero()});
-        observations.push_back({found, -1, true});
-        point_tracks[id].misses = 0;
+        searched.emplace_back(&track.history, observations.size());
+        observations.push_back({found, -1, true, false, track.keyframe_pixel, keyframes.at(p.reference).time});
+        track.history.misses = 0;
       } else {
-        observations.push_back({pixel, -1, false});
-        if (++point_tracks[id].misses > o.max_misses) missed_points.push_back(id);
+        observations.push_back({pixel, -1, false, false, track.keyframe_pixel, keyframes.at(p.reference).time});
+        ++track.history.misses;
       }
     }
     for (auto& [id, t] : plane_tracks) {
@@ -398,18 +428,28 @@ struct Odometry::Impl {
         Eigen::Vector2d found;
         if (Find(grey, keyframes.at(plane.reference).grey, h, pixel, jacobian, &found)) {
           measurements.push_back({id, found, o.pixel_sigma, m.ray});
-          observations.push_back({found, id, true});
-          m.count = 0;
+          searched.emplace_back(&m.history, observations.size());
+          observations.push_back({found, id, true, false, m.keyframe_pixel, keyframes.at(plane.reference).time});
+          m.history.misses = 0;
         } else {
-          observations.push_back({pixel, id, false});
-          ++m.count;
+          observations.push_back({pixel, id, false, false, m.keyframe_pixel, keyframes.at(plane.reference).time});
+          ++m.history.misses;
         }
       }
     }
-    const int used = UpdateRobustly(measurements);
-    frames_without_measurements = used == 0 ? frames_without_measurements + 1 : 0;
-    stats->measurements = used;
-    for (int id : missed_points) RemovePoint(id);
+    const std::vector<bool> used = UpdateRobustly(measurements);
+    for (size_t i = 0; i < used.size(); ++i) {
+      ++searched[i].first->matched;
+      searched[i].first->rejected += !used[i];
+      observations[searched[i].second].used = used[i];
+    }
+    stats->measurements = static_cast<int>(std::count(used.begin(), used.end(), true));
+    frames_without_measurements = stats->measurements == 0 ? frames_without_measurements + 1 : 0;
+    std::vector<int> bad;
+    for (const auto& [id, t] : point_tracks) {
+      if (Gone(t.history)) bad.push_back(id);
+    }
+    for (int id : bad) RemovePoint(id);
     if (o.mode == "idpp") GrowPlanes();
   }
 
@@ -424,7 +464,7 @@ struct Odometry::Impl {
     std::vector<int> to_points, empty;
     for (auto& [id, t] : plane_tracks) {
       ++t.age;
-      std::erase_if(t.members, [&](const PlanePoint& m) { return m.count > o.max_misses; });
+      std::erase_if(t.members, [&](const PlanePoint& m) { return Gone(m.history); });
       if (t.members.empty()) {
         empty.push_back(id);
         continue;
@@ -445,7 +485,7 @@ struct Odometry::Impl {
         const double on_plane = plane.plane.InverseDepthAlong(p.ray);
         const double plane_variance = InverseDepthVariance(plane, p.ray);
         if (std::abs(p.inverse_depth - on_plane) < 3 * std::sqrt(variance + plane_variance)) {
-          const PlanePoint joined{point_tracks.at(c.point).keyframe_pixel, p.ray, 0};
+          const PlanePoint joined{point_tracks.at(c.point).keyframe_pixel, p.ray, {}};
           filter->RemovePoint(c.point);
           point_tracks.erase(c.point);
           t.members.push_back(joined);
@@ -462,7 +502,7 @@ struct Odometry::Impl {
     for (int id : to_points) {
       const PlanePoint seed = plane_tracks.at(id).members.front();
       plane_tracks.erase(id);
-      point_tracks[filter->PlaneToPoint(id, seed.ray)] = {seed.keyframe_pixel, 0};
+      point_tracks[filter->PlaneToPoint(id, seed.ray)] = {seed.keyframe_pixel, {}};
       records.erase(id);
     }
   }
@@ -489,7 +529,7 @@ struct Odometry::Impl {
       if (rho <= 0) continue;
       corner.used = true;
       const int point = filter->AddPoint(plane.reference, ray, rho, rho_sigma_ratio * rho);
-      point_tracks[point] = {corner.pixel, 0};
+      point_tracks[point] = {corner.pixel, {}};
       t->candidates.push_back({point, 0});
       ++added;
     }
@@ -512,6 +552,7 @@ struct Odometry::Impl {
   FrameStats Track(const cv::Mat& grey, double timestamp) {
     FrameStats stats;
     stats.timestamp = timestamp;
+    now = timestamp;
     observations.clear();
     if (!started) {
       size = grey.size();

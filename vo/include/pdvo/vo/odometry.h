@@ -33,15 +33,19 @@ struct VoOptions {
   double search_sigmas = 3;         // search inside this Mahalanobis radius of the prediction
   int max_search_radius = 15;       // px, however uncertain the prediction
   double min_ncc = 0.8;             // a match needs at least this correlation
-  double pixel_sigma = 1.0;         // px, measurement noise
+  double pixel_sigma = 0.5;         // px, measurement noise
   int max_measurements = 200;       // per frame
   int min_features = 20;            // fewer visible: a new keyframe
   int new_features = 25;            // points initialised per keyframe, at most
   double min_distance = 12;         // px between features at initialisation
   int border = 10;                  // px: features nearer the image border leave
-  int max_misses = 3;               // consecutive failed searches before a point leaves
+  int max_misses = 3;               // consecutive failed searches before a feature leaves
+  // A feature also leaves when RANSAC has rejected at least min_rejections of its matches and more than this
+  // share of them: on synthetic streets half the matches straddle a depth edge, with errors of 1 px median.
+  int min_rejections = 3;
+  double max_rejected_share = 0.5;
   int ransac_hypotheses = 30;       // 1-point RANSAC over the matches
-  double ransac_threshold = 2.0;    // px: a match agrees with a hypothesis within this distance
+  double ransac_threshold = 1.0;    // px: a match agrees with a hypothesis within this distance
   // New points' prior: at the first keyframe this; later the median of the converged points in view, with
   // the same relative uncertainty (monocular: the map's scale is its own).
   double initial_inverse_depth = 0.2;        // 1/m
@@ -78,6 +82,8 @@ struct VoOptions {
     visit("min_distance", self.min_distance);
     visit("border", self.border);
     visit("max_misses", self.max_misses);
+    visit("min_rejections", self.min_rejections);
+    visit("max_rejected_share", self.max_rejected_share);
     visit("ransac_hypotheses", self.ransac_hypotheses);
     visit("ransac_threshold", self.ransac_threshold);
     visit("initial_inverse_depth", self.initial_inverse_depth);
@@ -111,11 +117,15 @@ struct FrameStats {
   bool lost = false;        // tracking failed at this frame and started again
 };
 
-// A feature as the last frame saw it (for drawing): where it was found, or predicted if it was not.
+// A feature as the last frame saw it: where it was found (or predicted, if the search failed), and where it
+// was initialised (for drawing tracks and checking matches against ground truth).
 struct Observation {
   Eigen::Vector2d pixel;
-  int plane = -1;        // the plane's id, or -1 for a point
-  bool matched = false;
+  int plane = -1;         // the plane's id, or -1 for a point
+  bool matched = false;   // the search found it
+  bool used = false;      // the update used the match (RANSAC inlier or rescued)
+  Eigen::Vector2d keyframe_pixel{0, 0};
+  double keyframe_time = 0;  // the timestamp of the frame it was initialised in
 };
 
 // A plane as mapped: its most points and the largest area (convex hull of its points, keyframe pixels).
