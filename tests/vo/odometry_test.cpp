@@ -72,7 +72,7 @@ TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
   const AteResult ate = ComputeAte(s.walk, estimate, Alignment::kSim3, 1e-3);
   const double length = PathLength(s.walk);
   EXPECT_EQ(ate.matched, s.walk.size());
-  // Measured 0.94% of the path on this street (0.7-1.7% over 1,000 frames of others, see README.md); a constant
+  // Measured 0.81% of the path on this street (0.5-2.0% over 1,000 frames of others, see README.md); a constant
   // velocity extrapolation of the first frame would be off by metres. The target of 1% is not met yet.
   EXPECT_LT(ate.translation.rmse, 0.03 * length) << "path " << length << " m";
   RecordProperty("ate_rmse_percent_of_path", std::to_string(100 * ate.translation.rmse / length));
