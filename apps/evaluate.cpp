@@ -21,7 +21,9 @@ int RunEvaluate(int argc, char** argv) {
   bool per_image = false;
   app.add_option("--model,-m", model_path, "Model file (from pdvo train)")->required();
   app.add_option("--annotations,-a", inputs, "Folders (or files) of annotations")->required();
-  app.add_option("--json", json_path, "Write the report (overall and per image) as JSON");
+  app.add_option("--json", json_path,
+                 "Write the report as JSON: overall, per image, and per region (box at the working resolution, "
+                 "truth, plane probability, predicted and true normal in the camera frame)");
   AddConfigFlags(app, &config_path, &overrides, "Region sampling options (YAML, section 'regions')",
                  "windows_per_shape=4");
   app.add_option("--seed", seed, "Seed for the sub-windows")->capture_default_str();
@@ -40,7 +42,20 @@ int RunEvaluate(int argc, char** argv) {
   for (const ImageEvaluation& r : rows) {
     skipped += r.skipped;
     const RecognitionMetrics mi = ComputeRecognitionMetrics(r.samples);
-    per_image_json.push_back({{"annotation", r.annotation_path}, {"skipped", r.skipped}, {"metrics", ToJson(mi)}});
+    nlohmann::json regions = nlohmann::json::array();
+    for (size_t k = 0; k < r.samples.size(); ++k) {
+      const RecognitionSample& s = r.samples[k];
+      const cv::Rect& b = r.boxes[k];
+      nlohmann::json region = {{"box", {b.x, b.y, b.width, b.height}},
+                               {"whole_shape", static_cast<bool>(r.whole_shapes[k])},
+                               {"planar", s.planar},
+                               {"probability", s.probability},
+                               {"normal", {s.normal.x(), s.normal.y(), s.normal.z()}}};
+      if (s.true_normal) region["true_normal"] = {s.true_normal->x(), s.true_normal->y(), s.true_normal->z()};
+      regions.push_back(region);
+    }
+    per_image_json.push_back(
+        {{"annotation", r.annotation_path}, {"skipped", r.skipped}, {"metrics", ToJson(mi)}, {"regions", regions}});
     if (per_image) {
       std::printf("%-40s regions %4d (skipped %3d) accuracy %.3f normal mean %5.1f deg\n",
                   std::filesystem::path(r.annotation_path).filename().c_str(), mi.regions, r.skipped, mi.accuracy,

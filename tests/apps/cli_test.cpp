@@ -1,7 +1,10 @@
 // The `pdvo` command end to end: exit codes, one-line errors that name the file, no partial output.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -255,6 +258,26 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   EXPECT_GT(overall["balanced_accuracy"].get<double>(), 0.85) << e.out;
   EXPECT_GT(overall["roc_auc"].get<double>(), 0.9) << e.out;
   EXPECT_LT(overall["normal_error_deg"]["mean"].get<double>(), 35) << e.out;
+  // Per region: as many as the image's metrics count, with a box and, for planes, both normals; the regions'
+  // normals reproduce the overall mean error.
+  double error_sum = 0;
+  int normals = 0, regions = 0;
+  for (const nlohmann::json& image : report["per_image"]) {
+    EXPECT_EQ(image["regions"].size(), image["metrics"]["regions"].get<size_t>());
+    for (const nlohmann::json& r : image["regions"]) {
+      ++regions;
+      EXPECT_EQ(r["box"].size(), 4u);
+      EXPECT_GT(r["box"][2].get<int>(), 0);
+      if (!r.contains("true_normal")) continue;
+      const Eigen::Vector3d n(r["normal"][0], r["normal"][1], r["normal"][2]);
+      const Eigen::Vector3d t(r["true_normal"][0], r["true_normal"][1], r["true_normal"][2]);
+      error_sum += std::acos(std::clamp(n.normalized().dot(t.normalized()), -1.0, 1.0)) * 180 / M_PI;
+      ++normals;
+    }
+  }
+  EXPECT_EQ(regions, overall["regions"].get<int>());
+  ASSERT_GT(normals, 0);
+  EXPECT_NEAR(error_sum / normals, overall["normal_error_deg"]["mean"].get<double>(), 1e-6);
 }
 
 TEST(Cli, TrainAndEvaluateRejectBadInputs) {

@@ -23,6 +23,8 @@ std::vector<ImageEvaluation> EvaluateRecogniser(const Recogniser& recogniser, co
         continue;
       }
       row.samples.push_back({r.planar, p.plane_probability, r.normal, p.normal});
+      row.boxes.push_back(r.region.box);
+      row.whole_shapes.push_back(r.whole_shape);
     }
     rows.push_back(std::move(row));
     progress.Step();

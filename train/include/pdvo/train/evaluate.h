@@ -16,6 +16,8 @@ struct ImageEvaluation {
   std::string annotation_path;
   int skipped = 0;  // regions with too few salient points
   std::vector<RecognitionSample> samples;
+  std::vector<cv::Rect> boxes;     // per sample: its region's bounding box (working resolution)
+  std::vector<bool> whole_shapes;  // per sample: the annotated polygon itself, not a sub-window
 };
 
 // One row per annotation file. Throws pdvo::Error naming a file that cannot be read.
