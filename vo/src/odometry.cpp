@@ -338,7 +338,7 @@ struct Odometry::Impl {
       }
     }
     if (most == 0) return used;
-    filter->Update(camera, Select(all, used, true));
+    filter->Update(camera, Select(all, used));
     // Rescue: the rest, gated on their innovation after the inliers' update.
     std::vector<bool> rescued(all.size(), false);
     for (size_t i = 0; i < all.size(); ++i) {
@@ -350,17 +350,17 @@ struct Odometry::Impl {
       const Eigen::Vector2d v = all[i].pixel - predicted;
       rescued[i] = v.dot(s.ldlt().solve(v)) < 9.21;  // chi-square(2), 99%
     }
-    const std::vector<PointMeasurement> more = Select(all, rescued, true);
+    const std::vector<PointMeasurement> more = Select(all, rescued);
     if (!more.empty()) filter->Update(camera, more);
     for (size_t i = 0; i < all.size(); ++i) used[i] = used[i] || rescued[i];
     return used;
   }
 
-  static std::vector<PointMeasurement> Select(const std::vector<PointMeasurement>& all, const std::vector<bool>& flags,
-                                              bool value) {
+  // The measurements whose flag is set.
+  static std::vector<PointMeasurement> Select(const std::vector<PointMeasurement>& all, const std::vector<bool>& flags) {
     std::vector<PointMeasurement> out;
     for (size_t i = 0; i < all.size(); ++i) {
-      if (flags[i] == value) out.push_back(all[i]);
+      if (flags[i]) out.push_back(all[i]);
     }
     return out;
   }
@@ -485,7 +485,8 @@ struct Odometry::Impl {
         const double on_plane = plane.plane.InverseDepthAlong(p.ray);
         const double plane_variance = InverseDepthVariance(plane, p.ray);
         if (std::abs(p.inverse_depth - on_plane) < 3 * std::sqrt(variance + plane_variance)) {
-          const PlanePoint joined{point_tracks.at(c.point).keyframe_pixel, p.ray, {}};
+          const PointTrack& track = point_tracks.at(c.point);
+          const PlanePoint joined{track.keyframe_pixel, p.ray, track.history};
           filter->RemovePoint(c.point);
           point_tracks.erase(c.point);
           t.members.push_back(joined);
