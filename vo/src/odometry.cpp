@@ -127,22 +127,35 @@ struct Odometry::Impl {
     return p.inverse_depth > 0 && std::sqrt(filter->covariance()(p.offset, p.offset)) < 0.3 * p.inverse_depth;
   }
 
-  // Inverse distances from the current camera of the converged points, sorted.
-  std::vector<double> ConvergedInverseDepths() const {
-    std::vector<double> out;
+  // The converged points as the current camera sees them: pixel and inverse distance.
+  std::vector<std::pair<Eigen::Vector2d, double>> ConvergedInView() const {
+    std::vector<std::pair<Eigen::Vector2d, double>> out;
     const Rigid3d cam_from_world = filter->camera().world_from_cam().Inverse();
+    Eigen::Vector2d pixel;
     for (const auto& [id, p] : filter->points()) {
-      if (!Converged(p)) continue;
+      if (!Converged(p) || !filter->PredictPoint(camera, id, &pixel, nullptr)) continue;
       const Rigid3d& ref = filter->references().at(p.reference).world_from_cam;
-      out.push_back(1 / (cam_from_world * (ref * (p.ray / p.inverse_depth))).norm());
+      out.emplace_back(pixel, 1 / (cam_from_world * (ref * (p.ray / p.inverse_depth))).norm());
     }
-    std::sort(out.begin(), out.end());
     return out;
+  }
+
+  // A new feature's inverse-depth prior at `pixel`: that of the converged point nearest in the image (depth
+  // varies smoothly over most of a scene, and the median of all of them is far off for features nearer or
+  // farther than most), or initial_inverse_depth while fewer than 5 have converged.
+  double PriorInverseDepth(const std::vector<std::pair<Eigen::Vector2d, double>>& converged,
+                           const Eigen::Vector2d& pixel) const {
+    if (converged.size() < 5) return o.initial_inverse_depth;
+    const auto nearest = std::min_element(converged.begin(), converged.end(), [&](const auto& a, const auto& b) {
+      return (a.first - pixel).squaredNorm() < (b.first - pixel).squaredNorm();
+    });
+    return nearest->second;
   }
 
   // A keyframe: corners away from the visible features; in idpp mode up to max_new_planes of them, where
   // corners are densest, seed planes (fronto-parallel, facing the keyframe); the strongest others become points.
-  // Priors: the median inverse depth of the converged points in view (the map keeps its own scale).
+  // Priors: PriorInverseDepth, with the same relative uncertainty as initial_inverse_depth_sigma (the map keeps
+  // its own scale).
   bool MakeKeyframe(const cv::Mat& grey) {
     cv::Mat mask(grey.size(), CV_8U, cv::Scalar(0));
     mask(cv::Rect(o.border, o.border, grey.cols - 2 * o.border, grey.rows - 2 * o.border)).setTo(255);
@@ -153,10 +166,8 @@ struct Odometry::Impl {
     std::vector<cv::Point2f> found;
     cv::goodFeaturesToTrack(grey, found, 4 * o.new_features, 0.01, o.min_distance, mask);
     if (found.empty()) return false;
-    double rho = o.initial_inverse_depth;
-    const std::vector<double> in_view = ConvergedInverseDepths();
-    if (in_view.size() >= 5) rho = in_view[in_view.size() / 2];
-    const double sigma = o.initial_inverse_depth_sigma / o.initial_inverse_depth * rho;
+    const auto converged = ConvergedInView();
+    const double sigma_ratio = o.initial_inverse_depth_sigma / o.initial_inverse_depth;
 
     const int reference = filter->AddReference();
     Keyframe& keyframe = keyframes[reference];
@@ -184,7 +195,8 @@ struct Odometry::Impl {
     for (int i : seeds) {
       corners[i].used = true;
       const Eigen::Vector3d ray = camera.Ray(corners[i].pixel);
-      const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, sigma);
+      const double rho = PriorInverseDepth(converged, corners[i].pixel);
+      const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, sigma_ratio * rho);
       plane_tracks[id].members.push_back({corners[i].pixel, ray, {}});
     }
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
@@ -193,7 +205,8 @@ struct Odometry::Impl {
       if (c.used || points + static_cast<int>(seeds.size()) >= o.new_features) continue;
       c.used = true;
       ++points;
-      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma)] = {c.pixel, {}};
+      const double rho = PriorInverseDepth(converged, c.pixel);
+      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma_ratio * rho)] = {c.pixel, {}};
     }
     return true;
   }

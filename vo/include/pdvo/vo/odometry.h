@@ -47,8 +47,8 @@ struct VoOptions {
   double max_rejected_share = 0.4;
   int ransac_hypotheses = 30;       // 1-point RANSAC over the matches
   double ransac_threshold = 1.0;    // px: a match agrees with a hypothesis within this distance
-  // New points' prior: at the first keyframe this; later the median of the converged points in view, with
-  // the same relative uncertainty (monocular: the map's scale is its own).
+  // New points' prior: at the first keyframe this; later that of the converged point nearest in the image,
+  // with the same relative uncertainty (monocular: the map's scale is its own).
   double initial_inverse_depth = 0.2;        // 1/m
   double initial_inverse_depth_sigma = 0.2;  // 1/m
   // The start is at rest. With a loose velocity prior as well as loose depths the scale is barely pinned and
