@@ -57,7 +57,8 @@ int RunVo(int argc, char** argv) {
   app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
   app.add_flag("--overlay", overlay,
                "Also write overlay.avi: each frame with its features (points green, plane points coloured by "
-               "plane; hollow where not found) and a status line");
+               "plane; filled where the update used the match, hollow where not found, red where RANSAC "
+               "rejected it) and a status line");
   AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "min_ncc=0.85");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);

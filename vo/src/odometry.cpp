@@ -37,7 +37,6 @@ struct Odometry::Impl {
   std::mt19937 rng{1};  // RANSAC; fixed seed: the same frames give the same trajectory
   double last_time = 0;
   bool started = false;
-  double now = 0;
   int frames_without_measurements = 0;
 
   // Per reference camera: its keyframe image and the corners found in it (planes grow over these).
@@ -87,7 +86,7 @@ struct Odometry::Impl {
            p.y() < size.height - o.border;
   }
 
-  void Start(const cv::Mat& grey, const CameraState& at) {
+  void Start(const cv::Mat& grey, double timestamp, const CameraState& at) {
     CameraState rest = at;
     rest.velocity.setZero();
     rest.angular_velocity.setZero();
@@ -100,7 +99,7 @@ struct Odometry::Impl {
     point_tracks.clear();
     plane_tracks.clear();
     frames_without_measurements = 0;
-    MakeKeyframe(grey);
+    MakeKeyframe(grey, timestamp);
   }
 
   bool Gone(const History& r) const {
@@ -132,10 +131,10 @@ struct Odometry::Impl {
     std::vector<std::pair<Eigen::Vector2d, double>> out;
     const Rigid3d cam_from_world = filter->camera().world_from_cam().Inverse();
     Eigen::Vector2d pixel;
+    Eigen::Vector3d x;
     for (const auto& [id, p] : filter->points()) {
-      if (!Converged(p) || !filter->PredictPoint(camera, id, &pixel, nullptr)) continue;
-      const Rigid3d& ref = filter->references().at(p.reference).world_from_cam;
-      out.emplace_back(pixel, 1 / (cam_from_world * (ref * (p.ray / p.inverse_depth))).norm());
+      if (!PointInWorld(id, &x) || !filter->PredictPoint(camera, id, &pixel, nullptr)) continue;
+      out.emplace_back(pixel, 1 / (cam_from_world * x).norm());
     }
     return out;
   }
@@ -152,11 +151,13 @@ struct Odometry::Impl {
     return nearest->second;
   }
 
+  // A prior's standard deviation: initial_inverse_depth_sigma's share of the prior.
+  double PriorSigma(double rho) const { return o.initial_inverse_depth_sigma / o.initial_inverse_depth * rho; }
+
   // A keyframe: corners away from the visible features; in idpp mode up to max_new_planes of them, where
   // corners are densest, seed planes (fronto-parallel, facing the keyframe); the strongest others become points.
-  // Priors: PriorInverseDepth, with the same relative uncertainty as initial_inverse_depth_sigma (the map keeps
-  // its own scale).
-  bool MakeKeyframe(const cv::Mat& grey) {
+  // Priors: PriorInverseDepth and PriorSigma (the map keeps its own scale).
+  bool MakeKeyframe(const cv::Mat& grey, double timestamp) {
     cv::Mat mask(grey.size(), CV_8U, cv::Scalar(0));
     mask(cv::Rect(o.border, o.border, grey.cols - 2 * o.border, grey.rows - 2 * o.border)).setTo(255);
     for (const Eigen::Vector2d& p : VisibleFeatures()) {
@@ -167,12 +168,11 @@ struct Odometry::Impl {
     cv::goodFeaturesToTrack(grey, found, 4 * o.new_features, 0.01, o.min_distance, mask);
     if (found.empty()) return false;
     const auto converged = ConvergedInView();
-    const double sigma_ratio = o.initial_inverse_depth_sigma / o.initial_inverse_depth;
 
     const int reference = filter->AddReference();
     Keyframe& keyframe = keyframes[reference];
     keyframe.grey = grey.clone();
-    keyframe.time = now;
+    keyframe.time = timestamp;
     for (const cv::Point2f& c : found) keyframe.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
     std::vector<Corner>& corners = keyframe.corners;
     std::vector<int> seeds;
@@ -196,7 +196,7 @@ struct Odometry::Impl {
       corners[i].used = true;
       const Eigen::Vector3d ray = camera.Ray(corners[i].pixel);
       const double rho = PriorInverseDepth(converged, corners[i].pixel);
-      const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, sigma_ratio * rho);
+      const int id = filter->AddPlane(reference, FrontoParallel(ray, rho), o.plane_sigma_normal, PriorSigma(rho));
       plane_tracks[id].members.push_back({corners[i].pixel, ray, {}});
     }
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
@@ -206,7 +206,7 @@ struct Odometry::Impl {
       c.used = true;
       ++points;
       const double rho = PriorInverseDepth(converged, c.pixel);
-      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, sigma_ratio * rho)] = {c.pixel, {}};
+      point_tracks[filter->AddPoint(reference, camera.Ray(c.pixel), rho, PriorSigma(rho))] = {c.pixel, {}};
     }
     return true;
   }
@@ -412,23 +412,29 @@ struct Odometry::Impl {
     std::vector<PointMeasurement> measurements;
     std::vector<std::pair<History*, size_t>> searched;  // per measurement: its feature's history, observation
     Eigen::MatrixXd jacobian;
+    // Searches for the feature predicted at `pixel` (with `jacobian`); `plane` is its plane's id or -1.
+    auto search = [&](int id, int plane, const Eigen::Vector3d& ray, int reference, const Eigen::Matrix3d& h,
+                      const Eigen::Vector2d& keyframe_pixel, History* history) {
+      ++stats->attempted;
+      const Keyframe& keyframe = keyframes.at(reference);
+      Eigen::Vector2d found;
+      const bool matched = Find(grey, keyframe.grey, h, pixel, jacobian, &found);
+      if (matched) {
+        measurements.push_back({id, found, o.pixel_sigma, ray});
+        searched.emplace_back(history, observations.size());
+        history->misses = 0;
+      } else {
+        ++history->misses;
+      }
+      observations.push_back({matched ? found : pixel, plane, matched, false, keyframe_pixel, keyframe.time});
+    };
     for (const auto& [id, p] : filter->points()) {
       if (stats->attempted >= o.max_measurements) break;
-      ++stats->attempted;
       filter->PredictPoint(camera, id, &pixel, &jacobian);
       const Eigen::Matrix3d h = PlaneHomography(camera, current, filter->references().at(p.reference).world_from_cam,
                                                 FrontoParallel(p.ray, std::max(p.inverse_depth, 1e-3)));
-      Eigen::Vector2d found;
       PointTrack& track = point_tracks.at(id);
-      if (Find(grey, keyframes.at(p.reference).grey, h, pixel, jacobian, &found)) {
-        measurements.push_back({id, found, o.pixel_sigma, Eigen::Vector3d::Zero()});
-        searched.emplace_back(&track.history, observations.size());
-        observations.push_back({found, -1, true, false, track.keyframe_pixel, keyframes.at(p.reference).time});
-        track.history.misses = 0;
-      } else {
-        observations.push_back({pixel, -1, false, false, track.keyframe_pixel, keyframes.at(p.reference).time});
-        ++track.history.misses;
-      }
+      search(id, -1, Eigen::Vector3d::Zero(), p.reference, h, track.keyframe_pixel, &track.history);
     }
     for (auto& [id, t] : plane_tracks) {
       const Filter::Plane& plane = filter->planes().at(id);
@@ -437,17 +443,7 @@ struct Odometry::Impl {
       for (PlanePoint& m : t.members) {
         if (stats->attempted >= o.max_measurements) break;
         if (!filter->PredictPlanePoint(camera, id, m.ray, &pixel, &jacobian) || !Inside(pixel)) continue;
-        ++stats->attempted;
-        Eigen::Vector2d found;
-        if (Find(grey, keyframes.at(plane.reference).grey, h, pixel, jacobian, &found)) {
-          measurements.push_back({id, found, o.pixel_sigma, m.ray});
-          searched.emplace_back(&m.history, observations.size());
-          observations.push_back({found, id, true, false, m.keyframe_pixel, keyframes.at(plane.reference).time});
-          m.history.misses = 0;
-        } else {
-          observations.push_back({pixel, id, false, false, m.keyframe_pixel, keyframes.at(plane.reference).time});
-          ++m.history.misses;
-        }
+        search(id, id, m.ray, plane.reference, h, m.keyframe_pixel, &m.history);
       }
     }
     const std::vector<bool> used = UpdateRobustly(measurements);
@@ -530,7 +526,6 @@ struct Odometry::Impl {
   void AddCandidates(int id, PlaneTrack* t) {
     const Filter::Plane& plane = filter->planes().at(id);
     Keyframe& keyframe = keyframes.at(plane.reference);
-    const double rho_sigma_ratio = o.initial_inverse_depth_sigma / o.initial_inverse_depth;
     int added = 0;
     for (Corner& corner : keyframe.corners) {
       if (added >= o.new_plane_points) break;
@@ -542,7 +537,7 @@ struct Odometry::Impl {
       const double rho = plane.plane.InverseDepthAlong(ray);
       if (rho <= 0) continue;
       corner.used = true;
-      const int point = filter->AddPoint(plane.reference, ray, rho, rho_sigma_ratio * rho);
+      const int point = filter->AddPoint(plane.reference, ray, rho, PriorSigma(rho));
       point_tracks[point] = {corner.pixel, {}};
       t->candidates.push_back({point, 0});
       ++added;
@@ -566,11 +561,10 @@ struct Odometry::Impl {
   FrameStats Track(const cv::Mat& grey, double timestamp) {
     FrameStats stats;
     stats.timestamp = timestamp;
-    now = timestamp;
     observations.clear();
     if (!started) {
       size = grey.size();
-      Start(grey, CameraState());
+      Start(grey, timestamp, CameraState());
       started = true;
       stats.keyframe = true;
     } else {
@@ -585,13 +579,11 @@ struct Odometry::Impl {
         CameraState at = filter->camera();
         if (!at.position.allFinite() || !at.orientation.coeffs().allFinite()) at = CameraState();
         for (const auto& [id, t] : plane_tracks) Record(id, t);
-        const Map current = CurrentMap();
-        mapped.points.insert(mapped.points.end(), current.points.begin(), current.points.end());
-        mapped.planes.insert(mapped.planes.end(), current.planes.begin(), current.planes.end());
-        Start(grey, at);
+        mapped.Append(CurrentMap());
+        Start(grey, timestamp, at);
         stats.keyframe = true;
       } else if (static_cast<int>(VisibleFeatures().size()) < o.min_features) {
-        stats.keyframe = MakeKeyframe(grey);
+        stats.keyframe = MakeKeyframe(grey, timestamp);
       }
     }
     last_time = timestamp;
@@ -627,9 +619,7 @@ Rigid3d Odometry::world_from_cam() const {
 Map Odometry::map() const {
   Map m = impl_->mapped;
   if (impl_->started) {
-    const Map current = impl_->CurrentMap();
-    m.points.insert(m.points.end(), current.points.begin(), current.points.end());
-    m.planes.insert(m.planes.end(), current.planes.begin(), current.planes.end());
+    m.Append(impl_->CurrentMap());
   }
   return m;
 }

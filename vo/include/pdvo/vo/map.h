@@ -18,6 +18,11 @@ struct MapPlane {
 struct Map {
   std::vector<Eigen::Vector3d> points;  // world
   std::vector<MapPlane> planes;
+
+  void Append(const Map& other) {
+    points.insert(points.end(), other.points.begin(), other.points.end());
+    planes.insert(planes.end(), other.planes.begin(), other.planes.end());
+  }
 };
 
 // ASCII PLY: vertices (x y z and an RGB colour: points grey, plane corners coloured by their normal, camera

@@ -42,7 +42,7 @@ struct VoOptions {
   int max_misses = 3;               // consecutive failed searches before a feature leaves
   // A feature also leaves when RANSAC has rejected at least min_rejections of its matches and more than this
   // share of them. On synthetic streets half the matches straddle a depth edge (errors 1 px median, biased);
-  // the rest are good to 0.33 px median, hence pixel_sigma and ransac_threshold.
+  // the rest are good to 0.32 px median, hence pixel_sigma and ransac_threshold.
   int min_rejections = 3;
   double max_rejected_share = 0.4;
   int ransac_hypotheses = 30;       // 1-point RANSAC over the matches
