@@ -125,6 +125,59 @@ TEST(Filter, PlaneBecomesAPointOnItsRay) {
   EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
 }
 
+// A point joining a plane: the constraint rho_point = rho_plane(ray) +- sigma fuses the two. Against the scalar
+// Kalman solution along the ray (point and plane start uncorrelated), and the whole covariance against the
+// update written out with a Jacobian by central differences.
+TEST(Filter, PointJoiningAPlaneIsFusedIntoIt) {
+  Filter f = BusyFilter();
+  const int plane = f.planes().begin()->first;
+  const int reference = f.planes().at(plane).reference;
+  const Eigen::Vector3d ray = kCamera.Ray({170, 130});
+  const double on_plane = f.planes().at(plane).plane.InverseDepthAlong(ray);
+  const int point = f.AddPoint(reference, ray, 1.1 * on_plane, 0.2 * on_plane);
+  const double sigma = 0.02 * on_plane;
+
+  const auto along_ray = [&](const Filter& g) { return g.planes().at(plane).plane.InverseDepthAlong(ray); };
+  const int n = f.size(), point_offset = f.points().at(point).offset;
+  Eigen::RowVectorXd h(n);  // d(rho_point - rho_plane(ray)) / d(error state)
+  for (int i = 0; i < n; ++i) {
+    Filter a = f, b = f;
+    a.Apply(1e-7 * Eigen::VectorXd::Unit(n, i));
+    b.Apply(-1e-7 * Eigen::VectorXd::Unit(n, i));
+    h[i] = (a.points().at(point).inverse_depth - along_ray(a) - b.points().at(point).inverse_depth + along_ray(b)) /
+           2e-7;
+  }
+  const Eigen::MatrixXd p = f.covariance();
+  const double s = (h * p * h.transpose())(0, 0) + sigma * sigma;
+  Eigen::MatrixXd expected = p - p * h.transpose() * h * p / s;
+  std::vector<int> keep;
+  for (int i = 0; i < n; ++i) {
+    if (i != point_offset) keep.push_back(i);
+  }
+  expected = Eigen::MatrixXd(expected(keep, keep));
+  Eigen::RowVectorXd h_plane = -h;  // d rho_plane(ray) / d(error state), without the point
+  h_plane[point_offset] = 0;
+  const double plane_variance = (h_plane * p * h_plane.transpose())(0, 0);
+  const double point_variance = p(point_offset, point_offset);
+  ASSERT_NEAR(point_variance, std::pow(0.2 * on_plane, 2), 1e-15);
+
+  f.MergePointIntoPlane(point, plane, sigma);
+  EXPECT_FALSE(f.points().count(point));
+  ASSERT_EQ(f.size(), n - 1);
+  const double gain = plane_variance / (plane_variance + point_variance + sigma * sigma);
+  EXPECT_GT(gain, 0.1);  // the test says something
+  EXPECT_NEAR(along_ray(f), on_plane + gain * 0.1 * on_plane, 1e-3 * on_plane);  // first order: to 0.1%
+  Eigen::RowVectorXd h_after(n - 1);
+  for (int i = 0, k = 0; i < n; ++i) {
+    if (i != point_offset) h_after[k++] = h_plane[i];
+  }
+  EXPECT_NEAR((h_after * f.covariance() * h_after.transpose())(0, 0), plane_variance * (1 - gain),
+              1e-6 * plane_variance);
+  EXPECT_LT((f.covariance() - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff());
+  EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
+  EXPECT_THROW(f.MergePointIntoPlane(point, plane, sigma), InvalidArgument);  // gone
+}
+
 TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   CameraState c;
   c.position = Eigen::Vector3d(1, 2, 3);

@@ -127,6 +127,26 @@ int Filter::PlaneToPoint(int plane_id, const Eigen::Vector3d& ray) {
   return id;
 }
 
+void Filter::MergePointIntoPlane(int point_id, int plane_id, double sigma) {
+  PDVO_THROW_CHECK(points_.count(point_id) && planes_.count(plane_id), InvalidArgument,
+                   "filter: no point " << point_id << " or plane " << plane_id);
+  const Point& p = points_.at(point_id);
+  const Plane& q = planes_.at(plane_id);
+  PDVO_THROW_CHECK(p.reference == q.reference && sigma > 0, InvalidArgument,
+                   "filter: point " << point_id << " cannot join plane " << plane_id);
+  // r = rho_point - rho_plane(ray), measured as 0.
+  Eigen::RowVectorXd h = Eigen::RowVectorXd::Zero(size());
+  h[p.offset] = 1;
+  h.segment<4>(q.offset) = -q.plane.InverseDepthJacobian(p.ray);
+  const double innovation = q.plane.InverseDepthAlong(p.ray) - p.inverse_depth;
+  const Eigen::VectorXd ph_t = covariance_ * h.transpose();
+  const double s = h.dot(ph_t) + sigma * sigma;
+  Apply(ph_t * (innovation / s));
+  covariance_ -= ph_t * ph_t.transpose() / s;
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+  RemovePoint(point_id);
+}
+
 void Filter::Renumber() {
   // Removal keeps the order of what stays: new offsets are the running sum of the block sizes in that order.
   struct Block {

@@ -73,6 +73,10 @@ class Filter {
   // A plane that could not grow becomes a point on `ray` (unit, reference frame): the point's inverse depth is
   // where the ray meets the plane, with the covariance that follows (first order). Returns the point's id.
   int PlaneToPoint(int plane, const Eigen::Vector3d& ray);
+  // A point of the plane's reference camera joins the plane: what the point's inverse depth says is fused into
+  // the plane (an update with the constraint rho_point = rho_plane(ray), standard deviation `sigma` in inverse
+  // depth: how far off the plane a point may be), then the point leaves the state.
+  void MergePointIntoPlane(int point, int plane, double sigma);
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.

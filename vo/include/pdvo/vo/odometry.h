@@ -8,7 +8,8 @@
 // Planes (mode idpp): at each keyframe, where corners are densest, planes are seeded at a corner, facing the
 // camera; each frame every plane takes up to 3 candidate points from its keyframe's corners near its members
 // (at least 12 px apart), each an inverse-depth point of its own until its depth is known: it joins the plane
-// if that depth agrees with the plane's (the 3D consistency test); a plane that has not reached 4 points after
+// if that depth agrees with the plane's (the 3D consistency test), and what it knows is fused into the plane
+// (Filter::MergePointIntoPlane); a plane that has not reached 4 points after
 // 10 frames becomes a point; planes that leave the view leave the filter and are kept
 // in the record (MappingStats).
 #pragma once
@@ -67,6 +68,7 @@ struct VoOptions {
                                     // a candidate not tested by then stays a point
   int min_plane_points = 4;
   double plane_sigma_normal = 0.5;  // prior standard deviation of each normal component (unit normal)
+  double planarity = 0.02;          // a joining point's depth off its plane: its relative standard deviation
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -100,6 +102,7 @@ struct VoOptions {
     visit("plane_grow_frames", self.plane_grow_frames);
     visit("min_plane_points", self.min_plane_points);
     visit("plane_sigma_normal", self.plane_sigma_normal);
+    visit("planarity", self.planarity);
   }
   bool Check() const;
   bool operator==(const VoOptions&) const = default;
