@@ -466,10 +466,10 @@ struct Odometry::Impl {
   // its ray meets the plane, 100% uncertain), measured like any point; once its inverse depth is known to 25%
   // (after at least candidate_frames frames) it joins the plane if that agrees with where its ray meets the
   // plane (within 3 combined standard deviations; its depth is then fused into the plane, up to `planarity`),
-  // otherwise it stays an ordinary point; one not known after
-  // plane_grow_frames stays a point too. Members missed too often leave; each plane takes up to
-  // new_plane_points new candidates a frame from its keyframe's corners near its members (at least
-  // min_distance apart); a plane that has not reached min_plane_points after plane_grow_frames becomes a point.
+  // otherwise it stays an ordinary point; one not known after plane_grow_frames stays a point too. Members
+  // missed too often leave; each plane takes up to new_plane_points new candidates a frame from its keyframe's
+  // corners near its members (at least min_distance apart); a plane with fewer than min_plane_points after
+  // plane_grow_frames becomes a point.
   void GrowPlanes() {
     std::vector<int> to_points, empty;
     for (auto& [id, t] : plane_tracks) {
