@@ -6,10 +6,10 @@
 // for several frames, or a non-finite state) it says so in the statistics and starts again from the last pose.
 //
 // Planes (mode idpp): at each keyframe, where corners are densest, planes are seeded at a corner, facing the
-// camera; each frame every plane takes up to 3 candidate points from its keyframe's corners near its members
-// (at least 12 px apart), each an inverse-depth point of its own until its depth is known: it joins the plane
-// if that depth agrees with the plane's (the 3D consistency test), and what it knows is fused into the plane
-// (Filter::MergePointIntoPlane); a plane with fewer than 4 points after 10 frames becomes a point (one that
+// camera; each frame every plane takes a candidate point (new_plane_points) from its keyframe's corners near
+// its members (at least 12 px apart), each an inverse-depth point of its own until its depth is known: it joins
+// the plane if that depth agrees with the plane's (the 3D consistency test), and what it knows is fused into
+// the plane (Filter::MergePointIntoPlane); a plane with fewer than 4 points after 10 frames becomes a point (one that
 // had reached 4 stays in the record, MappingStats); planes that leave the view leave the filter and are kept
 // in the record and the map.
 #pragma once
@@ -62,7 +62,7 @@ struct VoOptions {
   // Planes (mode idpp).
   int max_new_planes = 3;           // seeded per keyframe
   double grow_radius = 40;          // px in the keyframe: candidates this near a member; seeds twice apart
-  int new_plane_points = 3;         // candidates a plane takes per frame
+  int new_plane_points = 1;         // candidates a plane takes per frame (at most 3 in the paper; see README.md)
   int candidate_frames = 3;         // frames a candidate is tracked, at least, before its 3D test
   int plane_grow_frames = 10;       // a plane with fewer than min_plane_points after this becomes a point;
                                     // a candidate not tested by then stays a point
