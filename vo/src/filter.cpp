@@ -130,20 +130,17 @@ int Filter::PlaneToPoint(int plane_id, const Eigen::Vector3d& ray) {
 void Filter::MergePointIntoPlane(int point_id, int plane_id, double sigma) {
   PDVO_THROW_CHECK(points_.count(point_id) && planes_.count(plane_id), InvalidArgument,
                    "filter: no point " << point_id << " or plane " << plane_id);
+  PDVO_THROW_CHECK(sigma > 0, InvalidArgument, "filter: a plane merge needs a positive sigma, got " << sigma);
   const Point& p = points_.at(point_id);
   const Plane& q = planes_.at(plane_id);
-  PDVO_THROW_CHECK(p.reference == q.reference && sigma > 0, InvalidArgument,
-                   "filter: point " << point_id << " cannot join plane " << plane_id);
+  PDVO_THROW_CHECK(p.reference == q.reference, InvalidArgument,
+                   "filter: point " << point_id << " and plane " << plane_id << " have different reference cameras");
   // r = rho_point - rho_plane(ray), measured as 0.
-  Eigen::RowVectorXd h = Eigen::RowVectorXd::Zero(size());
-  h[p.offset] = 1;
-  h.segment<4>(q.offset) = -q.plane.InverseDepthJacobian(p.ray);
-  const double innovation = q.plane.InverseDepthAlong(p.ray) - p.inverse_depth;
-  const Eigen::VectorXd ph_t = covariance_ * h.transpose();
-  const double s = h.dot(ph_t) + sigma * sigma;
-  Apply(ph_t * (innovation / s));
-  covariance_ -= ph_t * ph_t.transpose() / s;
-  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(1, size());
+  h(0, p.offset) = 1;
+  h.block<1, 4>(0, q.offset) = -q.plane.InverseDepthJacobian(p.ray);
+  Correct(h, Eigen::VectorXd::Constant(1, q.plane.InverseDepthAlong(p.ray) - p.inverse_depth),
+          Eigen::VectorXd::Constant(1, sigma * sigma));
   RemovePoint(point_id);
 }
 
@@ -223,6 +220,10 @@ double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>
     innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
     noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
   }
+  return Correct(h, innovation, noise);
+}
+
+double Filter::Correct(const Eigen::MatrixXd& h, const Eigen::VectorXd& innovation, const Eigen::VectorXd& noise) {
   const Eigen::MatrixXd ph_t = covariance_ * h.transpose();
   Eigen::MatrixXd s = h * ph_t;
   s.diagonal() += noise;

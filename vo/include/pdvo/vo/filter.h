@@ -97,6 +97,9 @@ class Filter {
   void Apply(const Eigen::VectorXd& delta);
 
  private:
+  // The EKF correction for measurements with Jacobian `h` (rows x size()), `innovation` (measured - predicted)
+  // and independent noise variances; returns the normalised innovation squared.
+  double Correct(const Eigen::MatrixXd& h, const Eigen::VectorXd& innovation, const Eigen::VectorXd& noise);
   void Remove(std::vector<int> dropped, int reference);
   void Renumber();
   // Grows the covariance by variances.size() rows and columns, zero but for `variances` on the new diagonal.

@@ -9,9 +9,9 @@
 // camera; each frame every plane takes a candidate point (new_plane_points) from its keyframe's corners near
 // its members (at least 12 px apart), each an inverse-depth point of its own until its depth is known: it joins
 // the plane if that depth agrees with the plane's (the 3D consistency test), and what it knows is fused into
-// the plane (Filter::MergePointIntoPlane); a plane with fewer than 4 points after 10 frames becomes a point (one that
-// had reached 4 stays in the record, MappingStats); planes that leave the view leave the filter and are kept
-// in the record and the map.
+// the plane (Filter::MergePointIntoPlane); a plane with fewer than 4 points after 10 frames becomes a point
+// (one that had reached 4 stays in the record, MappingStats, but not in the map); planes that leave the view
+// leave the filter and are kept in the record and the map.
 #pragma once
 
 #include <map>
