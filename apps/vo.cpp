@@ -78,7 +78,7 @@ int RunVo(int argc, char** argv) {
 
   StagedOutputDir out(out_dir);
   SaveOptions(out.path("vo.yaml"), options, "vo");
-  Trajectory trajectory;
+  size_t tracked = 0;
   nlohmann::json frames = nlohmann::json::array();
   double seconds = 0;
   int lost = 0, keyframes = 0;
@@ -90,7 +90,7 @@ int RunVo(int argc, char** argv) {
     PDVO_THROW_CHECK(video.isOpened(), IoError, out.final_path("overlay.avi") << ": cannot open a video writer");
   }
   Frame frame;
-  while ((max_frames == 0 || trajectory.size() < max_frames) && sequence->Next(&frame)) {
+  while ((max_frames == 0 || tracked < max_frames) && sequence->Next(&frame)) {
     PDVO_THROW_CHECK(frame.image.cols == camera.width && frame.image.rows == camera.height, FormatError,
                      frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
                                       << ", the camera says " << camera.width << "x" << camera.height);
@@ -102,11 +102,12 @@ int RunVo(int argc, char** argv) {
     seconds += s.seconds;
     lost += s.lost;
     keyframes += s.keyframe;
-    trajectory.push_back({frame.timestamp, odometry.world_from_cam()});
+    ++tracked;
     frames.push_back({{"t", s.timestamp}, {"seconds", s.seconds}, {"attempted", s.attempted},
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
                       {"plane_points", s.plane_points},
-                      {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost}});
+                      {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost},
+                      {"bootstrap", s.bootstrap}});
     if (overlay) video.write(DrawOverlay(colour, odometry.observations(), s));
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
                      std::to_string(s.planes) + " planes");
@@ -114,7 +115,8 @@ int RunVo(int argc, char** argv) {
   }
   progress.Finish();
   video.release();
-  PDVO_THROW_CHECK(!trajectory.empty(), FormatError, sequence_path << ": no frames");
+  PDVO_THROW_CHECK(tracked > 0, FormatError, sequence_path << ": no frames");
+  const Trajectory& trajectory = odometry.trajectory();  // with the poses the bootstrap revised
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const vo::Map map = odometry.map();
   vo::WritePly(out.path("map.ply"), map, trajectory);

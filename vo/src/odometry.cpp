@@ -5,9 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/vo/patch.h"
 
 namespace pdvo::vo {
@@ -25,6 +28,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
   PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0);
   PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0);
+  PDVO_CHECK_OPTION(bootstrap_frames >= 0 && bootstrap_parallax > 0 && bootstrap_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
   return true;
 }
@@ -86,20 +90,190 @@ struct Odometry::Impl {
            p.y() < size.height - o.border;
   }
 
+  // Features' priors: pixel and inverse distance (PriorInverseDepth takes the nearest).
+  using Priors = std::vector<std::pair<Eigen::Vector2d, double>>;
+
+  // Starts at rest at `at` with generic priors, and arms the two-view bootstrap.
   void Start(const cv::Mat& grey, double timestamp, const CameraState& at) {
     CameraState rest = at;
     rest.velocity.setZero();
     rest.angular_velocity.setZero();
+    Restart(grey, timestamp, rest, o.initial_velocity_sigma, nullptr);
+    boot = {};
+    if (o.bootstrap_frames == 0) return;
+    std::vector<cv::Point2f> corners;
+    cv::goodFeaturesToTrack(grey, corners, kBootstrapCorners, 0.01, o.min_distance, InsideMask(grey.size()));
+    boot.active = corners.size() >= kBootstrapInliers;
+    boot.tracks = {corners};
+    boot.previous = grey.clone();
+    boot.time = timestamp;
+    boot.index = trajectory.size();
+    boot.first = rest;
+  }
+
+  // A new filter holding only the camera `at` (its position and orientation fixed: the gauge) and a keyframe.
+  void Restart(const cv::Mat& grey, double timestamp, const CameraState& at, double velocity_sigma,
+               const Priors* priors) {
     Vector12d sigma;
-    sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6),
-        Eigen::Vector3d::Constant(o.initial_velocity_sigma),
+    sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(velocity_sigma),
         Eigen::Vector3d::Constant(o.angular_acceleration * 1.0);  // rad/s: one second of angular acceleration
-    filter = std::make_unique<Filter>(rest, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
+    filter = std::make_unique<Filter>(at, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     keyframes.clear();
     point_tracks.clear();
     plane_tracks.clear();
     frames_without_measurements = 0;
-    MakeKeyframe(grey, timestamp);
+    MakeKeyframe(grey, timestamp, priors);
+  }
+
+  // The two-view bootstrap. A monocular filter started at rest has to find the speed and the depths together,
+  // and while the velocity prior holds the speed near zero the map takes a scale that then drifts for a few
+  // hundred frames (synthetic streets: the first 100 frames at 0.7 of the later scale). So the corners of the
+  // first frame are tracked (pyramidal Lucas-Kanade) while the filter runs; once an essential matrix between
+  // the first frame and the current one has enough inliers, seen under a median parallax of at least
+  // bootstrap_parallax degrees, the filter starts again at the current frame with that motion's mean velocity
+  // (known to bootstrap_velocity_sigma of itself) and the triangulated depths as its features' priors, at the
+  // scale that puts their median at 1 / initial_inverse_depth (the acceleration noise is in metres, and street
+  // scenes are a few metres deep). The poses of the frames in between are replaced by the poses that fit the
+  // triangulated corners (PnP). Without enough parallax after bootstrap_frames (e.g. a camera that only
+  // rotates) the filter simply goes on.
+  static constexpr int kBootstrapCorners = 200;
+  static constexpr size_t kBootstrapInliers = 30;
+  struct Bootstrap {
+    bool active = false;
+    double time = 0;     // of the first frame
+    size_t index = 0;    // of the first frame in `trajectory`
+    CameraState first;   // the camera at the first frame
+    cv::Mat previous;    // the last frame
+    std::vector<std::vector<cv::Point2f>> tracks;  // per frame since the first, the corners still tracked
+  } boot;
+  // What the bootstrap found: the motion and the triangulated inliers (first camera, at the map's scale).
+  struct TwoViewMotion {
+    Rigid3d first_from_current;
+    std::vector<int> inliers;  // indices into the tracks
+    std::vector<Eigen::Vector3d> points;
+  };
+  Trajectory trajectory;  // every frame's pose
+
+  cv::Mat InsideMask(const cv::Size& image) const {
+    cv::Mat mask(image, CV_8U, cv::Scalar(0));
+    mask(cv::Rect(o.border, o.border, image.width - 2 * o.border, image.height - 2 * o.border)).setTo(255);
+    return mask;
+  }
+
+  // Tracks the bootstrap's corners into `grey`; true if the filter started again.
+  bool StepBootstrap(const cv::Mat& grey, double timestamp) {
+    std::vector<cv::Point2f> next;
+    std::vector<uchar> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(boot.previous, grey, boot.tracks.back(), next, status, error, cv::Size(21, 21), 3);
+    boot.tracks.push_back(next);
+    size_t kept = 0;
+    for (size_t i = 0; i < next.size(); ++i) {
+      if (!status[i] || !Inside(Eigen::Vector2d(next[i].x, next[i].y))) continue;
+      for (std::vector<cv::Point2f>& frame : boot.tracks) frame[kept] = frame[i];
+      ++kept;
+    }
+    for (std::vector<cv::Point2f>& frame : boot.tracks) frame.resize(kept);
+    boot.previous = grey.clone();
+    if (kept < kBootstrapInliers || static_cast<int>(boot.tracks.size()) > o.bootstrap_frames + 1) {
+      boot = {};
+      return false;
+    }
+    TwoViewMotion motion;
+    if (!TwoView(&motion)) return false;
+    const Rigid3d& first_from_current = motion.first_from_current;
+    CameraState at;
+    const Rigid3d world_from_first = boot.first.world_from_cam();
+    const Rigid3d world_from_current = world_from_first * first_from_current;
+    at.position = world_from_current.translation;
+    at.orientation = world_from_current.rotation;
+    const double dt = timestamp - boot.time;
+    at.velocity = (at.position - boot.first.position) / dt;
+    at.angular_velocity = LogSO3(first_from_current.rotation) / dt;
+    // The frames in between (the tracks' frames 1 .. size - 2 are trajectory[index + 1 ..]).
+    std::vector<cv::Point3d> points;
+    for (const Eigen::Vector3d& x : motion.points) points.emplace_back(x.x(), x.y(), x.z());
+    for (size_t f = 1; f + 1 < boot.tracks.size(); ++f) {
+      std::vector<cv::Point2d> pixels;
+      for (int i : motion.inliers) pixels.emplace_back(boot.tracks[f][i]);
+      // Start from the pose interpolated between the first and the current camera.
+      const double share = static_cast<double>(f) / (boot.tracks.size() - 1);
+      const Rigid3d guess(Eigen::Quaterniond::Identity().slerp(share, first_from_current.rotation),
+                          share * first_from_current.translation);
+      const Rigid3d cam_from_first = guess.Inverse();
+      const Eigen::Vector3d angle_axis = LogSO3(cam_from_first.rotation);
+      cv::Mat rvec = (cv::Mat_<double>(3, 1) << angle_axis.x(), angle_axis.y(), angle_axis.z());
+      cv::Mat tvec = (cv::Mat_<double>(3, 1) << cam_from_first.translation.x(), cam_from_first.translation.y(),
+                      cam_from_first.translation.z());
+      Rigid3d first_from_frame = guess;
+      if (cv::solvePnP(points, pixels, CameraMatrix(), cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) {
+        const Eigen::Vector3d r(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2));
+        first_from_frame = Rigid3d(ExpSO3(r), Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2))).Inverse();
+      }
+      trajectory.at(boot.index + f).world_from_cam = world_from_first * first_from_frame;
+    }
+    Priors priors;
+    const Rigid3d current_from_first = first_from_current.Inverse();
+    for (size_t j = 0; j < motion.inliers.size(); ++j) {
+      const cv::Point2f& pixel = boot.tracks.back()[motion.inliers[j]];
+      priors.emplace_back(Eigen::Vector2d(pixel.x, pixel.y), 1 / (current_from_first * motion.points[j]).norm());
+    }
+    PDVO_LOG(Debug) << "vo: two-view bootstrap after " << boot.tracks.size() - 1 << " frames, " << priors.size()
+                    << " triangulated corners, direction " << first_from_current.translation.normalized().transpose();
+    boot = {};
+    Restart(grey, timestamp, at, o.bootstrap_velocity_sigma * at.velocity.norm(), &priors);
+    return true;
+  }
+
+  cv::Matx33d CameraMatrix() const { return {camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1}; }
+
+  // The essential matrix between the bootstrap's first and last frame (RANSAC, 1 px), its motion and the
+  // triangulated inliers, scaled so that their median distance is 1 / initial_inverse_depth; false if there
+  // are too few inliers or too little parallax.
+  bool TwoView(TwoViewMotion* motion) const {
+    const std::vector<cv::Point2f>& from = boot.tracks.front();
+    const std::vector<cv::Point2f>& to = boot.tracks.back();
+    cv::Mat inliers;
+    const cv::Mat e = cv::findEssentialMat(from, to, CameraMatrix(), cv::RANSAC, 0.999, 1.0, inliers);
+    if (e.rows != 3 || e.cols != 3) return false;
+    cv::Mat r, t, triangulated;
+    cv::recoverPose(e, from, to, CameraMatrix(), r, t, 1e6, inliers, triangulated);
+    // x_current = R x_first + t, |t| = 1.
+    Eigen::Matrix3d rotation;
+    Eigen::Vector3d translation;
+    for (int i = 0; i < 3; ++i) {
+      translation(i) = t.at<double>(i);
+      for (int j = 0; j < 3; ++j) rotation(i, j) = r.at<double>(i, j);
+    }
+    triangulated.convertTo(triangulated, CV_64F);
+    const Eigen::Vector3d centre = -rotation.transpose() * translation;  // of the current camera, first frame
+    std::vector<double> parallax, distance;
+    motion->inliers.clear();
+    motion->points.clear();
+    for (int i = 0; i < inliers.rows; ++i) {
+      if (!inliers.at<uchar>(i)) continue;
+      const Eigen::Vector4d h(triangulated.at<double>(0, i), triangulated.at<double>(1, i),
+                              triangulated.at<double>(2, i), triangulated.at<double>(3, i));
+      if (std::abs(h(3)) < 1e-12) continue;
+      const Eigen::Vector3d x = h.hnormalized();
+      const Eigen::Vector3d in_current = rotation * x + translation;
+      if (x.z() <= 0 || in_current.z() <= 0) continue;
+      parallax.push_back(std::acos(std::clamp(x.normalized().dot((x - centre).normalized()), -1.0, 1.0)));
+      distance.push_back(in_current.norm());
+      motion->inliers.push_back(i);
+      motion->points.push_back(x);
+    }
+    const size_t n = motion->inliers.size();
+    if (n < kBootstrapInliers || 2 * n < to.size()) return false;
+    auto median = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    if (median(parallax) < o.bootstrap_parallax * M_PI / 180) return false;
+    const double scale = 1 / (o.initial_inverse_depth * median(distance));
+    for (Eigen::Vector3d& x : motion->points) x *= scale;
+    motion->first_from_current = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre * scale);
+    return true;
   }
 
   bool Gone(const History& r) const {
@@ -127,8 +301,8 @@ struct Odometry::Impl {
   }
 
   // The converged points as the current camera sees them: pixel and inverse distance.
-  std::vector<std::pair<Eigen::Vector2d, double>> ConvergedInView() const {
-    std::vector<std::pair<Eigen::Vector2d, double>> out;
+  Priors ConvergedInView() const {
+    Priors out;
     const Rigid3d cam_from_world = filter->camera().world_from_cam().Inverse();
     Eigen::Vector2d pixel;
     Eigen::Vector3d x;
@@ -142,8 +316,7 @@ struct Odometry::Impl {
   // A new feature's inverse-depth prior at `pixel`: that of the converged point nearest in the image (depth
   // varies smoothly over most of a scene, and the median of all of them is far off for features nearer or
   // farther than most), or initial_inverse_depth while fewer than 5 have converged.
-  double PriorInverseDepth(const std::vector<std::pair<Eigen::Vector2d, double>>& converged,
-                           const Eigen::Vector2d& pixel) const {
+  double PriorInverseDepth(const Priors& converged, const Eigen::Vector2d& pixel) const {
     if (converged.size() < 5) return o.initial_inverse_depth;
     const auto nearest = std::min_element(converged.begin(), converged.end(), [&](const auto& a, const auto& b) {
       return (a.first - pixel).squaredNorm() < (b.first - pixel).squaredNorm();
@@ -157,9 +330,8 @@ struct Odometry::Impl {
   // A keyframe: corners away from the visible features; in idpp mode up to max_new_planes of them, where
   // corners are densest, seed planes (fronto-parallel, facing the keyframe); the strongest others become points.
   // Priors: PriorInverseDepth and PriorSigma (the map keeps its own scale).
-  bool MakeKeyframe(const cv::Mat& grey, double timestamp) {
-    cv::Mat mask(grey.size(), CV_8U, cv::Scalar(0));
-    mask(cv::Rect(o.border, o.border, grey.cols - 2 * o.border, grey.rows - 2 * o.border)).setTo(255);
+  bool MakeKeyframe(const cv::Mat& grey, double timestamp, const Priors* priors = nullptr) {
+    cv::Mat mask = InsideMask(grey.size());
     for (const Eigen::Vector2d& p : VisibleFeatures()) {
       cv::circle(mask, cv::Point(cvRound(p.x()), cvRound(p.y())), static_cast<int>(o.min_distance), cv::Scalar(0),
                  cv::FILLED);
@@ -167,7 +339,7 @@ struct Odometry::Impl {
     std::vector<cv::Point2f> found;
     cv::goodFeaturesToTrack(grey, found, 4 * o.new_features, 0.01, o.min_distance, mask);
     if (found.empty()) return false;
-    const auto converged = ConvergedInView();
+    const Priors converged = priors ? *priors : ConvergedInView();
 
     const int reference = filter->AddReference();
     Keyframe& keyframe = keyframes[reference];
@@ -583,11 +755,14 @@ struct Odometry::Impl {
         mapped.Append(CurrentMap());
         Start(grey, timestamp, at);
         stats.keyframe = true;
+      } else if (boot.active && StepBootstrap(grey, timestamp)) {
+        stats.keyframe = stats.bootstrap = true;
       } else if (static_cast<int>(VisibleFeatures().size()) < o.min_features) {
         stats.keyframe = MakeKeyframe(grey, timestamp);
       }
     }
     last_time = timestamp;
+    trajectory.push_back({timestamp, filter->camera().world_from_cam()});
     stats.points = static_cast<int>(filter->points().size());
     stats.planes = static_cast<int>(filter->planes().size());
     for (const auto& [id, t] : plane_tracks) stats.plane_points += static_cast<int>(t.members.size());
@@ -626,6 +801,8 @@ Map Odometry::map() const {
 }
 
 const std::vector<Observation>& Odometry::observations() const { return impl_->observations; }
+
+const Trajectory& Odometry::trajectory() const { return impl_->trajectory; }
 
 MappingStats Odometry::mapping() const {
   MappingStats m;

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "pdvo/common/options.h"
+#include "pdvo/common/trajectory.h"
 #include "pdvo/vo/filter.h"
 #include "pdvo/vo/map.h"
 
@@ -56,7 +57,12 @@ struct VoOptions {
   // the first frames can settle on a wrong direction of motion (measured on synthetic streets with exact
   // measurements): the velocity prior is tight and the acceleration noise lets it grow.
   double initial_velocity_sigma = 0.1;       // m/s
-  double linear_acceleration = 0.5;          // m/s^2, process noise
+  // The two-view bootstrap (odometry.cpp): frames it may take (0: none), the median parallax it needs, and
+  // the velocity's standard deviation after it, as a share of the speed it found.
+  int bootstrap_frames = 60;
+  double bootstrap_parallax = 1.5;           // degrees
+  double bootstrap_velocity_sigma = 0.2;
+  double linear_acceleration = 0.25;         // m/s^2, process noise
   double angular_acceleration = 4.0;         // rad/s^2; a second of it is the starting angular velocity sigma
   int lost_after = 5;               // frames without any measurement before starting again
   // Planes (mode idpp).
@@ -92,6 +98,9 @@ struct VoOptions {
     visit("initial_inverse_depth", self.initial_inverse_depth);
     visit("initial_inverse_depth_sigma", self.initial_inverse_depth_sigma);
     visit("initial_velocity_sigma", self.initial_velocity_sigma);
+    visit("bootstrap_frames", self.bootstrap_frames);
+    visit("bootstrap_parallax", self.bootstrap_parallax);
+    visit("bootstrap_velocity_sigma", self.bootstrap_velocity_sigma);
     visit("linear_acceleration", self.linear_acceleration);
     visit("angular_acceleration", self.angular_acceleration);
     visit("lost_after", self.lost_after);
@@ -119,6 +128,7 @@ struct FrameStats {
   int state_size = 0;
   bool keyframe = false;
   bool lost = false;        // tracking failed at this frame and started again
+  bool bootstrap = false;   // the filter started again here from the two-view bootstrap
 };
 
 // A feature as the last frame saw it: where it was found (or predicted, if the search failed), and where it
@@ -152,7 +162,11 @@ class Odometry {
 
   // One 8-bit grey frame; timestamps must increase.
   FrameStats Track(const cv::Mat& grey, double timestamp);
+  // The pose of the last frame.
   Rigid3d world_from_cam() const;
+  // The pose of every frame so far. Those of the frames before the two-view bootstrap are revised when it
+  // succeeds (VoOptions::bootstrap_frames), so that the whole trajectory has one scale.
+  const Trajectory& trajectory() const;
   const Filter& filter() const;
   MappingStats mapping() const;
   // Points and planes mapped so far: those that left the filter and those in it.
