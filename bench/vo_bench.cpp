@@ -3,9 +3,11 @@
 // path length, keyframes, lost-track events, the filter's consistency (NEES of the camera orientation, which
 // monocular VO observes without scale, against the ground truth expressed in the first camera's frame), and the
 // resident memory of tracking (rendered frames excluded). The NEES takes the camera the filter fixed when it
-// started (the first frame, or the frame of the two-view bootstrap) as exact.
+// started (the first frame, or the frame of the two-view bootstrap) as exact. In idpp mode, the purity of the
+// planes: how many of their points lie on the same true surface.
 // Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp pixel_sigma=0.5)
 #include <chrono>
+#include <map>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
@@ -45,21 +47,24 @@ int main(int argc, char** argv) {
   const pdvo::sim::Street street = pdvo::sim::GenerateStreet(options.street, length + 30, seed);
   const pdvo::Trajectory walk = pdvo::sim::WalkStreet(street, options.walk, frames, seed);
   std::vector<cv::Mat> grey;
-  {
-    const pdvo::sim::Renderer renderer(street, camera, options.render, seed);
-    for (const pdvo::StampedPose& pose : walk) {
-      pdvo::sim::RenderedFrame frame;
-      renderer.Render({pose.world_from_cam}, pose.timestamp, grey.size(), &frame);
-      cv::Mat g;
-      cv::cvtColor(frame.image, g, cv::COLOR_BGR2GRAY);
-      grey.push_back(g);
-    }
+  const pdvo::sim::Renderer renderer(street, camera, options.render, seed);
+  for (const pdvo::StampedPose& pose : walk) {
+    pdvo::sim::RenderedFrame frame;
+    renderer.Render({pose.world_from_cam}, pose.timestamp, grey.size(), &frame);
+    cv::Mat g;
+    cv::cvtColor(frame.image, g, cv::COLOR_BGR2GRAY);
+    grey.push_back(g);
   }
   const double before = ResidentMiB();
   pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, vo_options);
   int keyframes = 0, lost = 0, bootstrap = -1;
   double measurements = 0, peak = before, nees_sum = 0;
   int nees_frames = 0, nees_inside = 0;
+  struct Member {  // a plane's point in view, for the purity below
+    int frame, plane, keyframe;
+    Eigen::Vector2d keyframe_pixel;
+  };
+  std::vector<Member> members;
   // The filter fixes the orientation of the camera it starts at (the gauge), the first frame's and again the
   // frame of a restart (bootstrap or lost): the truth is compared in that camera's frame.
   Eigen::Quaterniond gauge = walk.front().world_from_cam.rotation.conjugate();
@@ -81,6 +86,12 @@ int main(int argc, char** argv) {
       ++nees_frames;
       nees_inside += nees < 7.815;  // chi-square(3), 95%
     }
+    for (const pdvo::vo::Observation& o : odometry.observations()) {
+      if (o.plane >= 0) {
+        const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
+        members.push_back({static_cast<int>(k), o.plane, keyframe, o.keyframe_pixel});
+      }
+    }
     if (k % 100 == 0) peak = std::max(peak, ResidentMiB());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -88,6 +99,32 @@ int main(int argc, char** argv) {
   const pdvo::AteResult ate = pdvo::ComputeAte(walk, odometry.trajectory(), pdvo::Alignment::kSim3, 1e-3);
   const double path = pdvo::PathLength(walk);
   const pdvo::vo::MappingStats mapping = odometry.mapping();
+  // Plane purity: per frame, each plane's members (if 4 or more) by the true surface at their keyframe pixel
+  // (coplanar polygons share a surface; non-planar objects and the sky count as one other); the share of them
+  // on their plane's most common surface.
+  std::map<int, cv::Mat> surfaces;  // by keyframe: the true ids
+  std::map<std::pair<int, int>, std::map<int, int>> by_surface;  // (frame, plane) -> surface -> members
+  for (const Member& m : members) {
+    cv::Mat& id = surfaces[m.keyframe];
+    if (id.empty()) {
+      pdvo::sim::RenderedFrame geometry;
+      renderer.RenderGeometry(walk.at(m.keyframe).world_from_cam, &geometry);
+      id = geometry.id;
+    }
+    const int at = id.at<int>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
+    ++by_surface[{m.frame, m.plane}][at >= 0 ? street.planes.at(at).surface : -1];
+  }
+  long plane_members = 0, majority_members = 0;
+  for (const auto& [frame_plane, counts] : by_surface) {
+    int all = 0, most = 0;
+    for (const auto& [surface, n] : counts) {
+      all += n;
+      most = std::max(most, n);
+    }
+    if (all < 4) continue;
+    plane_members += all;
+    majority_members += most;
+  }
   std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,
               static_cast<unsigned long long>(seed), vo_options.mode.c_str(), path);
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
@@ -97,6 +134,10 @@ int main(int argc, char** argv) {
               nees_sum / std::max(1, nees_frames), 100.0 * nees_inside / std::max(1, nees_frames));
   std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times; two-view bootstrap at frame %d\n",
               measurements / frames, keyframes, lost, bootstrap);
+  if (plane_members > 0) {
+    std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n",
+                static_cast<double>(majority_members) / plane_members);
+  }
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
               mapping.points_per_plane, mapping.mean_plane_area);
   std::printf("  memory           %.1f MiB resident with the frames, tracking added %.1f MiB (peak %.1f MiB)\n",

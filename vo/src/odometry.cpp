@@ -26,7 +26,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(mode == "idpp" || mode == "points");
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
   PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
-  PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0);
+  PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0 && join_gate > 0);
   PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0);
   PDVO_CHECK_OPTION(bootstrap_frames >= 0 && bootstrap_parallax > 0 && bootstrap_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
@@ -641,7 +641,7 @@ struct Odometry::Impl {
   // The 3D consistency test of plane growing: a candidate is an inverse-depth point of its own (prior: where
   // its ray meets the plane, 100% uncertain), measured like any point; once its inverse depth is known to 25%
   // (after at least candidate_frames frames) it joins the plane if that agrees with where its ray meets the
-  // plane (within 3 combined standard deviations; its depth is then fused into the plane, up to `planarity`),
+  // plane (within join_gate combined standard deviations; its depth is then fused into the plane, up to `planarity`),
   // otherwise it stays an ordinary point; one not known after plane_grow_frames stays a point too. Members
   // missed too often leave; each plane takes up to new_plane_points new candidates a frame from its keyframe's
   // corners near its members (at least min_distance apart); a plane with fewer than min_plane_points after
@@ -670,7 +670,7 @@ struct Odometry::Impl {
         if (p.reference != plane.reference) continue;
         const double on_plane = plane.plane.InverseDepthAlong(p.ray);
         const double plane_variance = InverseDepthVariance(plane, p.ray);
-        if (on_plane > 0 && std::abs(p.inverse_depth - on_plane) < 3 * std::sqrt(variance + plane_variance)) {
+        if (on_plane > 0 && std::abs(p.inverse_depth - on_plane) < o.join_gate * std::sqrt(variance + plane_variance)) {
           const PointTrack& track = point_tracks.at(c.point);
           const PlanePoint joined{track.keyframe_pixel, p.ray, track.history};
           filter->MergePointIntoPlane(c.point, id, o.planarity * on_plane);

@@ -70,6 +70,10 @@ struct VoOptions {
   double grow_radius = 40;          // px in the keyframe: candidates this near a member; seeds twice apart
   int new_plane_points = 1;         // candidates a plane takes per frame (at most 3 in the paper; see README.md)
   int candidate_frames = 3;         // frames a candidate is tracked, at least, before its 3D test
+  // The 3D test: a candidate joins if its inverse depth and its plane's along its ray agree within this many
+  // combined standard deviations. With 3, a third of the members of a plane lay on another surface of the
+  // synthetic streets (vo_bench's purity); with 2, a fifth.
+  double join_gate = 2;
   int plane_grow_frames = 10;       // a plane with fewer than min_plane_points after this becomes a point;
                                     // a candidate not tested by then stays a point
   int min_plane_points = 4;
@@ -108,6 +112,7 @@ struct VoOptions {
     visit("grow_radius", self.grow_radius);
     visit("new_plane_points", self.new_plane_points);
     visit("candidate_frames", self.candidate_frames);
+    visit("join_gate", self.join_gate);
     visit("plane_grow_frames", self.plane_grow_frames);
     visit("min_plane_points", self.min_plane_points);
     visit("plane_sigma_normal", self.plane_sigma_normal);
