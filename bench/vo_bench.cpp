@@ -7,9 +7,9 @@
 // planes: how many of their points lie on the same true surface.
 // Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp pixel_sigma=0.5)
 #include <chrono>
-#include <map>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/geometry.h"
