@@ -59,7 +59,7 @@ struct VoOptions {
   double initial_velocity_sigma = 0.1;       // m/s
   // The two-view bootstrap (odometry.cpp): frames it may take (0: none), the median parallax it needs, and
   // the velocity's standard deviation after it, as a share of the speed it found.
-  int bootstrap_frames = 60;
+  int bootstrap_frames = 90;
   double bootstrap_parallax = 1.5;           // degrees
   double bootstrap_velocity_sigma = 0.2;
   double linear_acceleration = 0.25;         // m/s^2, process noise
