@@ -15,6 +15,7 @@
 #include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 
+#include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
 #include "memory.h"
 #include "pdvo/sim/renderer.h"
@@ -103,7 +104,7 @@ int main(int argc, char** argv) {
   // (coplanar polygons share a surface; non-planar objects and the sky count as one other); the share of them
   // on their plane's most common surface.
   std::map<int, cv::Mat> surfaces;  // by keyframe: the true ids
-  std::map<std::pair<int, int>, std::map<int, int>> by_surface;  // (frame, plane) -> surface -> members
+  pdvo::PlanePurity purity;
   for (const Member& m : members) {
     cv::Mat& id = surfaces[m.keyframe];
     if (id.empty()) {
@@ -112,19 +113,10 @@ int main(int argc, char** argv) {
       id = geometry.id;
     }
     const int at = id.at<int>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
-    ++by_surface[{m.frame, m.plane}][at >= 0 ? street.planes.at(at).surface : -1];
+    purity.Add(m.frame, m.plane, at >= 0 ? street.planes.at(at).surface : -1);
   }
-  long plane_members = 0, majority_members = 0;
-  for (const auto& [frame_plane, counts] : by_surface) {
-    int all = 0, most = 0;
-    for (const auto& [surface, n] : counts) {
-      all += n;
-      most = std::max(most, n);
-    }
-    if (all < 4) continue;
-    plane_members += all;
-    majority_members += most;
-  }
+  long plane_members = 0;
+  const double pure = purity.Share(4, &plane_members);
   std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,
               static_cast<unsigned long long>(seed), vo_options.mode.c_str(), path);
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
@@ -135,8 +127,7 @@ int main(int argc, char** argv) {
   std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times; two-view bootstrap at frame %d\n",
               measurements / frames, keyframes, lost, bootstrap);
   if (plane_members > 0) {
-    std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n",
-                static_cast<double>(majority_members) / plane_members);
+    std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n", pure);
   }
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
               mapping.points_per_plane, mapping.mean_plane_area);

@@ -147,4 +147,20 @@ nlohmann::json ToJson(const std::vector<PlaneComparison>& comparisons) {
   return j;
 }
 
+double PlanePurity::Share(int min_points, long* points) const {
+  long all = 0, on_main = 0;
+  for (const auto& [group, by_label] : counts_) {
+    int n = 0, most = 0;
+    for (const auto& [label, count] : by_label) {
+      n += count;
+      most = std::max(most, count);
+    }
+    if (n < min_points) continue;
+    all += n;
+    on_main += most;
+  }
+  if (points) *points = all;
+  return all > 0 ? static_cast<double>(on_main) / all : 0.0;
+}
+
 }  // namespace pdvo

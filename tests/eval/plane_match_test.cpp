@@ -54,5 +54,20 @@ TEST(PlaneMatch, OneToOneAndUnmatchedCountAsZero) {
   EXPECT_THROW(ComparePlanes(ref, other), InvalidArgument);
 }
 
+TEST(PlanePurity, ShareOfPointsOnTheirPlanesMainLabel) {
+  PlanePurity purity;
+  // Frame 0: plane 1 has 3 points on surface 7 and 1 on surface 8; plane 2 has 2 points only (too few).
+  for (int label : {7, 7, 8, 7}) purity.Add(0, 1, label);
+  for (int label : {5, 6}) purity.Add(0, 2, label);
+  // Frame 1: plane 1 again, 4 points on 4 surfaces.
+  for (int label : {1, 2, 3, 4}) purity.Add(1, 1, label);
+  long points = 0;
+  EXPECT_DOUBLE_EQ(purity.Share(4, &points), (3.0 + 1.0) / 8.0);
+  EXPECT_EQ(points, 8);
+  EXPECT_DOUBLE_EQ(purity.Share(1), (3.0 + 1.0 + 1.0) / 10.0);
+  EXPECT_DOUBLE_EQ(PlanePurity().Share(1, &points), 0.0);
+  EXPECT_EQ(points, 0);
+}
+
 }  // namespace
 }  // namespace pdvo

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
@@ -233,39 +233,31 @@ TEST(Odometry, IdppModeGrowsPlanes) {
 
 // A plane's points lie on one true surface: in every frame, of the points of each plane in view (4 or more),
 // the share on the plane's most common surface (by the rendered ids at their keyframe pixels).
-double PlanePurity(const Street& s, const VoOptions& options) {
+double PurityOfPlanes(const Street& s, const VoOptions& options) {
   Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, options);
-  long all = 0, on_main = 0;
+  PlanePurity purity;
   for (size_t k = 0; k < s.grey.size(); ++k) {
     odometry.Track(s.grey[k], s.walk[k].timestamp);
-    std::map<int, std::map<int, int>> by_surface;  // plane -> surface -> points
     for (const Observation& o : odometry.observations()) {
       if (o.plane < 0) continue;
       const size_t key = static_cast<size_t>(std::lround(o.keyframe_time * s.options.walk.fps));
-      ++by_surface[o.plane][s.surface.at(key).at<int16_t>(cvRound(o.keyframe_pixel.y()), cvRound(o.keyframe_pixel.x()))];
-    }
-    for (const auto& [plane, counts] : by_surface) {
-      int n = 0, most = 0;
-      for (const auto& [surface, c] : counts) {
-        n += c;
-        most = std::max(most, c);
-      }
-      if (n < 4) continue;
-      all += n;
-      on_main += most;
+      purity.Add(static_cast<int>(k), o.plane,
+                 s.surface.at(key).at<int16_t>(cvRound(o.keyframe_pixel.y()), cvRound(o.keyframe_pixel.x())));
     }
   }
-  EXPECT_GT(all, 100);
-  return static_cast<double>(on_main) / std::max(1L, all);
+  long points = 0;
+  const double share = purity.Share(4, &points);
+  EXPECT_GT(points, 100);
+  return share;
 }
 
 TEST(Odometry, PlanePointsLieOnOneSurface) {
   const Street& s = TestStreet();
   VoOptions options;
   options.mode = "idpp";
-  const double purity = PlanePurity(s, options);
+  const double purity = PurityOfPlanes(s, options);
   options.join_gate = 3;
-  const double loose = PlanePurity(s, options);
+  const double loose = PurityOfPlanes(s, options);
   // Measured on this street: 0.78 with the default gate of 2 standard deviations, 0.39 with 3.
   EXPECT_GT(purity, 0.7);
   EXPECT_GT(purity, loose);

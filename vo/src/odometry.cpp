@@ -134,8 +134,9 @@ struct Odometry::Impl {
   // (known to bootstrap_velocity_sigma of itself) and the triangulated depths as its features' priors, at the
   // scale that puts their median at 1 / initial_inverse_depth (the acceleration noise is in metres, and street
   // scenes are a few metres deep). The poses of the frames in between are replaced by the poses that fit the
-  // triangulated corners (PnP). Without enough parallax after bootstrap_frames (e.g. a camera that only
-  // rotates) the filter simply goes on. Known weakness: the frame-to-frame tracks drift, which adds parallax, so
+  // triangulated corners (PnP); what the filter had mapped before it is dropped (it is at the former scale),
+  // while the planes it recorded stay counted. Without enough parallax after bootstrap_frames (e.g. a camera
+  // that only rotates) the filter simply goes on. Known weakness: the frame-to-frame tracks drift, which adds parallax, so
   // far corners come out too near (on the odometry test's street the priors are 24% nearer than the motion's
   // scale says, and the filter settles to another scale after the bootstrap). Tracking from the first frame with
   // each corner's own triangulation uncertainty removes that bias but measured worse over 1,000 frames (streets

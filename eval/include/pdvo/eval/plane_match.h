@@ -5,8 +5,10 @@
 // image's size (or scaled to `max_width`).
 #pragma once
 
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pdvo/annotations/annotation.h"
@@ -45,5 +47,18 @@ PlaneComparisonSummary Summarise(const std::vector<PlaneComparison>& comparisons
 
 // {"summary": {...}, "frames": [{"name", "reference_planes", "estimated_planes", "matches": [...]}]}
 nlohmann::json ToJson(const std::vector<PlaneComparison>& comparisons);
+
+// The purity of planes built from points (the odometry's): each point of a plane, seen in a frame, carries a
+// label, e.g. the true surface it lies on. Over the (frame, plane) groups of at least `min_points`, the share of
+// points that carry their group's most common label.
+class PlanePurity {
+ public:
+  void Add(int frame, int plane, int label) { ++counts_[{frame, plane}][label]; }
+  // 0 if no group is large enough; `points` (optional): how many points the share is over.
+  double Share(int min_points, long* points = nullptr) const;
+
+ private:
+  std::map<std::pair<int, int>, std::map<int, int>> counts_;  // (frame, plane) -> label -> points
+};
 
 }  // namespace pdvo
