@@ -81,7 +81,10 @@ struct Odometry::Impl {
     int age = 0;                      // frames since the plane was made
   };
   std::map<int, PlaneTrack> plane_tracks;  // by plane id
-  std::map<int, PlaneRecord> records;      // every plane that reached min_plane_points, by plane id
+  // Every plane that reached min_plane_points, by (generation, plane id): each start is a new filter, whose
+  // ids start again.
+  std::map<std::pair<int, int>, PlaneRecord> records;
+  int generation = 0;                      // filters started so far
   Map mapped;                              // features that left the filter
   std::vector<Observation> observations;   // of the last frame
 
@@ -121,6 +124,7 @@ struct Odometry::Impl {
     keyframes.clear();
     point_tracks.clear();
     plane_tracks.clear();
+    ++generation;
     frames_without_measurements = 0;
     MakeKeyframe(grey, timestamp, priors);
   }
@@ -448,7 +452,7 @@ struct Odometry::Impl {
 
   void Record(int id, const PlaneTrack& t) {
     if (static_cast<int>(t.members.size()) < o.min_plane_points) return;
-    PlaneRecord& r = records[id];
+    PlaneRecord& r = records[{generation, id}];
     r.points = std::max(r.points, static_cast<int>(t.members.size()));
     r.area = std::max(r.area, Area(t));
   }
