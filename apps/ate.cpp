@@ -13,7 +13,9 @@ namespace pdvo::apps {
 int RunAte(int argc, char** argv) {
   CLI::App app("Compares an estimated trajectory with ground truth: poses are associated by timestamp, the "
                "estimate is aligned (se3: rigid; sim3: with scale, for monocular runs; none), and the absolute "
-               "trajectory error (ATE) and the relative pose error (RPE) are reported.",
+               "trajectory error (ATE) and the relative pose error (RPE) are reported. The ATE's rotation part "
+               "compares the orientations after the rotation that best aligns them (the positions alone hardly "
+               "fix the rotation about a straight path).",
                "pdvo ate");
   std::string gt_path, est_path, format_name = "tum", align_name = "sim3", gt_times, est_times, json_path;
   std::string rpe_unit = "frames", verbosity = "info";

@@ -1,6 +1,7 @@
 #include "pdvo/eval/trajectory_error.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
@@ -103,11 +104,26 @@ AteResult ComputeAte(const Trajectory& gt, const Trajectory& est, Alignment alig
   AteResult r;
   r.matched = pairs.size();
   if (alignment != Alignment::kNone) r.gt_from_estimate = AlignPoints(src, dst, alignment == Alignment::kSim3);
+  // Orientations are compared after the rotation that best aligns them (the chordal mean of gt * est^-1), not
+  // the positions' rotation: along a nearly straight path the positions hardly fix the rotation about it.
+  Eigen::Quaterniond orientation_alignment = Eigen::Quaterniond::Identity();
+  if (alignment != Alignment::kNone) {
+    Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+    for (const auto& [g, e] : pairs) {
+      sum += gt[g].world_from_cam.rotation.toRotationMatrix() *
+             est[e].world_from_cam.rotation.toRotationMatrix().transpose();
+    }
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
+    flip(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
+    orientation_alignment = Eigen::Quaterniond(svd.matrixU() * flip * svd.matrixV().transpose());
+  }
   std::vector<double> trans, rot;
   for (const auto& [g, e] : pairs) {
     const Rigid3d aligned = r.gt_from_estimate * est[e].world_from_cam;
     trans.push_back((aligned.translation - gt[g].world_from_cam.translation).norm());
-    rot.push_back(AngularDistance(aligned.rotation, gt[g].world_from_cam.rotation) * 180.0 / M_PI);
+    rot.push_back(AngularDistance(orientation_alignment * est[e].world_from_cam.rotation,
+                                  gt[g].world_from_cam.rotation) * 180.0 / M_PI);
   }
   r.translation = ComputeStats(trans);
   r.rotation_deg = ComputeStats(rot);

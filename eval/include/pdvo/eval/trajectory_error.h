@@ -4,7 +4,9 @@
 // and no pose is used twice (greedily, closest pairs first). The estimate is then aligned to the ground truth
 // by Umeyama's method on the positions (Eigen::umeyama): a rigid motion (se3), a similarity (sim3, for
 // monocular estimates whose scale is unknown) or nothing (none). ATE is the distance between aligned
-// positions; RPE compares the motion between two poses `delta` frames or seconds apart, after scaling the
+// positions; its rotation part, the angle between orientations after the rotation that best aligns the
+// orientations (with se3 or sim3; along a nearly straight path the positions alone leave the rotation about it
+// to their wobble); RPE compares the motion between two poses `delta` frames or seconds apart, after scaling the
 // estimate by the alignment's scale.
 #pragma once
 
@@ -40,7 +42,7 @@ struct AteResult {
   size_t matched = 0;       // associated pose pairs
   Sim3d gt_from_estimate;   // the alignment applied to the estimate
   ErrorStats translation;   // metres (ground-truth units)
-  ErrorStats rotation_deg;  // orientation error after alignment, degrees
+  ErrorStats rotation_deg;  // orientation error after the orientations' own alignment, degrees
 };
 
 // Throws InvalidArgument if fewer than 3 poses associate (1 for "none").
