@@ -27,7 +27,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
   PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
   PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0 && join_gate > 0);
-  PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0);
+  PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0 && initial_angular_velocity_sigma > 0);
   PDVO_CHECK_OPTION(bootstrap_frames >= 0 && bootstrap_parallax > 0 && bootstrap_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
   return true;
@@ -119,7 +119,7 @@ struct Odometry::Impl {
                const Priors* priors) {
     Vector12d sigma;
     sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(velocity_sigma),
-        Eigen::Vector3d::Constant(o.angular_acceleration * 1.0);  // rad/s: one second of angular acceleration
+        Eigen::Vector3d::Constant(o.initial_angular_velocity_sigma);
     filter = std::make_unique<Filter>(at, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     keyframes.clear();
     point_tracks.clear();

@@ -57,6 +57,10 @@ struct VoOptions {
   // the first frames can settle on a wrong direction of motion (measured on synthetic streets with exact
   // measurements): the velocity prior is tight and the acceleration noise lets it grow.
   double initial_velocity_sigma = 0.1;       // m/s
+  // The angular velocity's standard deviation at each start and at the bootstrap (whose two-view rotation it
+  // then keeps). A hand-held or walking camera turns at a few tenths of a radian per second; much looser (it
+  // was 4 rad/s) lets the filter trade rotation for translation after a slightly wrong start (seed 69).
+  double initial_angular_velocity_sigma = 0.5;  // rad/s
   // The two-view bootstrap (odometry.cpp): frames it may take (0: none), the median parallax it needs, and
   // the velocity's standard deviation after it, as a share of the speed it found.
   int bootstrap_frames = 90;
@@ -102,6 +106,7 @@ struct VoOptions {
     visit("initial_inverse_depth", self.initial_inverse_depth);
     visit("initial_inverse_depth_sigma", self.initial_inverse_depth_sigma);
     visit("initial_velocity_sigma", self.initial_velocity_sigma);
+    visit("initial_angular_velocity_sigma", self.initial_angular_velocity_sigma);
     visit("bootstrap_frames", self.bootstrap_frames);
     visit("bootstrap_parallax", self.bootstrap_parallax);
     visit("bootstrap_velocity_sigma", self.bootstrap_velocity_sigma);
