@@ -97,7 +97,8 @@ TEST(Odometry, BootstrapFindsTheMotion) {
       at = static_cast<int>(k);
       const Rigid3d truth = s.walk[0].world_from_cam.Inverse() * s.walk[k].world_from_cam;
       const Rigid3d estimate = odometry.world_from_cam();  // the first camera is the world
-      const double angle = std::acos(std::clamp(truth.translation.normalized().dot(estimate.translation.normalized()), -1.0, 1.0));
+      const double angle = std::acos(
+          std::clamp(truth.translation.normalized().dot(estimate.translation.normalized()), -1.0, 1.0));
       EXPECT_LT(angle * 180 / M_PI, 3.0);  // measured 0.41 deg
       EXPECT_LT(LogSO3(truth.rotation.conjugate() * estimate.rotation).norm() * 180 / M_PI, 0.5);  // measured 0.18 deg
     }
@@ -109,7 +110,8 @@ TEST(Odometry, BootstrapFindsTheMotion) {
   EXPECT_TRUE(trajectory.back().world_from_cam.translation.isApprox(odometry.world_from_cam().translation));
   // The revised poses before the bootstrap move forward, in the direction of the truth.
   for (int k = 1; k < at; ++k) {
-    const Eigen::Vector3d step = trajectory[k].world_from_cam.translation - trajectory[k - 1].world_from_cam.translation;
+    const Eigen::Vector3d step =
+        trajectory[k].world_from_cam.translation - trajectory[k - 1].world_from_cam.translation;
     const Eigen::Vector3d true_step = s.walk[0].world_from_cam.rotation.conjugate() *
                                       (s.walk[k].world_from_cam.translation - s.walk[k - 1].world_from_cam.translation);
     EXPECT_GT(step.normalized().dot(true_step.normalized()), std::cos(20 * M_PI / 180)) << "frame " << k;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -27,7 +28,8 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > min_distance && new_plane_points >= 1);
   PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
   PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0 && join_gate > 0);
-  PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0 && initial_angular_velocity_sigma > 0);
+  PDVO_CHECK_OPTION(initial_inverse_depth_sigma > 0 && initial_velocity_sigma > 0 &&
+                    initial_angular_velocity_sigma > 0);
   PDVO_CHECK_OPTION(bootstrap_frames >= 0 && bootstrap_parallax > 0 && bootstrap_velocity_sigma > 0);
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
   return true;
@@ -118,8 +120,8 @@ struct Odometry::Impl {
   void Restart(const cv::Mat& grey, double timestamp, const CameraState& at, double velocity_sigma,
                const Priors* priors) {
     Vector12d sigma;
-    sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(velocity_sigma),
-        Eigen::Vector3d::Constant(o.initial_angular_velocity_sigma);
+    sigma << Eigen::Vector3d::Constant(1e-6), Eigen::Vector3d::Constant(1e-6),
+        Eigen::Vector3d::Constant(velocity_sigma), Eigen::Vector3d::Constant(o.initial_angular_velocity_sigma);
     filter = std::make_unique<Filter>(at, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     keyframes.clear();
     point_tracks.clear();
@@ -140,8 +142,8 @@ struct Odometry::Impl {
   // scenes are a few metres deep). The poses of the frames in between are replaced by the poses that fit the
   // triangulated corners (PnP); what the filter had mapped before it is dropped (it is at the former scale),
   // while the planes it recorded stay counted. Without enough parallax after bootstrap_frames (e.g. a camera
-  // that only rotates) the filter simply goes on. Known weakness: the frame-to-frame tracks drift, which adds parallax, so
-  // far corners come out too near (on the odometry test's street the priors are 24% nearer than the motion's
+  // that only rotates) the filter simply goes on. Known weakness: the frame-to-frame tracks drift, which adds
+  // parallax, so far corners come out too near (on the odometry test's street the priors are 24% nearer than the motion's
   // scale says, and the filter settles to another scale after the bootstrap). Tracking from the first frame with
   // each corner's own triangulation uncertainty removes that bias but measured worse over 1,000 frames (streets
   // 31-54: 0.92 against 0.71%; 101-124: 1.45 against 0.77%), so it is not used.
@@ -210,14 +212,15 @@ struct Odometry::Impl {
       const Rigid3d guess(Eigen::Quaterniond::Identity().slerp(share, first_from_current.rotation),
                           share * first_from_current.translation);
       const Rigid3d cam_from_first = guess.Inverse();
-      const Eigen::Vector3d angle_axis = LogSO3(cam_from_first.rotation);
-      cv::Mat rvec = (cv::Mat_<double>(3, 1) << angle_axis.x(), angle_axis.y(), angle_axis.z());
-      cv::Mat tvec = (cv::Mat_<double>(3, 1) << cam_from_first.translation.x(), cam_from_first.translation.y(),
-                      cam_from_first.translation.z());
+      Eigen::Vector3d r = LogSO3(cam_from_first.rotation), t = cam_from_first.translation;  // OpenCV's rvec, tvec
+      cv::Mat rvec, tvec;
+      cv::eigen2cv(r, rvec);
+      cv::eigen2cv(t, tvec);
       Rigid3d first_from_frame = guess;
       if (cv::solvePnP(points, pixels, CameraMatrix(), cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) {
-        const Eigen::Vector3d r(rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2));
-        first_from_frame = Rigid3d(ExpSO3(r), Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2))).Inverse();
+        cv::cv2eigen(rvec, r);
+        cv::cv2eigen(tvec, t);
+        first_from_frame = Rigid3d(ExpSO3(r), t).Inverse();
       }
       trajectory.at(boot.index + f).world_from_cam = world_from_first * first_from_frame;
     }
@@ -250,10 +253,8 @@ struct Odometry::Impl {
     // x_current = R x_first + t, |t| = 1.
     Eigen::Matrix3d rotation;
     Eigen::Vector3d translation;
-    for (int i = 0; i < 3; ++i) {
-      translation(i) = t.at<double>(i);
-      for (int j = 0; j < 3; ++j) rotation(i, j) = r.at<double>(i, j);
-    }
+    cv::cv2eigen(r, rotation);
+    cv::cv2eigen(t, translation);
     triangulated.convertTo(triangulated, CV_64F);
     const Eigen::Vector3d centre = -rotation.transpose() * translation;  // of the current camera, first frame
     std::vector<double> parallax, distance;

@@ -67,7 +67,7 @@ struct VoOptions {
   double bootstrap_parallax = 1.5;           // degrees
   double bootstrap_velocity_sigma = 0.2;
   double linear_acceleration = 0.25;         // m/s^2, process noise
-  double angular_acceleration = 4.0;         // rad/s^2; a second of it is the starting angular velocity sigma
+  double angular_acceleration = 4.0;         // rad/s^2, process noise
   int lost_after = 5;               // frames without any measurement before starting again
   // Planes (mode idpp).
   int max_new_planes = 3;           // seeded per keyframe
