@@ -32,10 +32,10 @@ Filter BusyFilter() {
   c.velocity = Eigen::Vector3d(0.8, 0.05, 0.2);
   c.angular_velocity = Eigen::Vector3d(0.05, 0.3, -0.02);
   Filter f(c, SmallCovariance());
-  const int r0 = f.AddReference();
+  const int r0 = f.AddReference(false);
   for (int k = 0; k < 3; ++k) f.AddPoint(r0, kCamera.Ray({80.0 + 60 * k, 100.0 + 10 * k}), 0.2 + 0.1 * k, 0.1);
   for (int k = 0; k < 5; ++k) f.Predict(1.0 / 30, {});
-  const int r1 = f.AddReference();
+  const int r1 = f.AddReference(false);
   for (int k = 0; k < 2; ++k) f.AddPoint(r1, kCamera.Ray({120.0 + 50 * k, 90.0}), 0.3, 0.2);
   f.AddPlane(r0, {Eigen::Vector3d(0.3, -0.1, -1.0), 0.2}, 0.2, 0.05);
   f.Predict(1.0 / 30, {});
@@ -183,7 +183,7 @@ TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   c.position = Eigen::Vector3d(1, 2, 3);
   Filter f(c, SmallCovariance());
   f.Predict(0.1, {});
-  const int r = f.AddReference();
+  const int r = f.AddReference(false);
   const Filter::Reference& ref = f.references().at(r);
   EXPECT_EQ(ref.offset, 12);
   EXPECT_EQ(ref.world_from_cam.translation, f.camera().position);
@@ -191,6 +191,40 @@ TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   EXPECT_TRUE((p.block(12, 12, 6, 6).array() == p.block(0, 0, 6, 6).array()).all());
   EXPECT_TRUE((p.block(12, 0, 6, 12).array() == p.block(0, 0, 6, 12).array()).all());
   EXPECT_LT((f.covariance() - f.covariance().transpose()).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+// A fixed reference is exact: no variance, no correlation, and updates through its points move the camera and
+// the points but never it.
+TEST(Filter, FixedReferenceIsNotMovedByUpdates) {
+  CameraState c;
+  c.velocity = Eigen::Vector3d(0.5, 0, 1);
+  Filter f(c, SmallCovariance());
+  f.Predict(0.1, {0.5, 0.5});
+  const int r = f.AddReference(true);
+  const Rigid3d pose = f.references().at(r).world_from_cam;
+  EXPECT_EQ(pose.translation, f.camera().position);
+  EXPECT_TRUE(f.covariance().middleRows(12, 6).isZero(0));
+  EXPECT_TRUE(f.covariance().middleCols(12, 6).isZero(0));
+  std::vector<int> points;
+  for (int k = 0; k < 6; ++k) points.push_back(f.AddPoint(r, kCamera.Ray({60.0 + 40 * k, 80.0 + 15 * k}), 0.25, 0.1));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0, 0.5);
+  const Eigen::Vector3d camera_before = f.camera().position;
+  for (int frame = 0; frame < 10; ++frame) {
+    f.Predict(1.0 / 30, {0.5, 0.5});
+    std::vector<PointMeasurement> z;
+    for (int id : points) {
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, nullptr));
+      z.push_back({id, pixel + Eigen::Vector2d(2 + noise(rng), noise(rng)), 0.5});  // all shifted 2 px right
+    }
+    f.Update(kCamera, z);
+  }
+  EXPECT_EQ(f.references().at(r).world_from_cam.translation, pose.translation);
+  EXPECT_EQ(f.references().at(r).world_from_cam.rotation.coeffs(), pose.rotation.coeffs());
+  EXPECT_TRUE(f.covariance().middleRows(12, 6).isZero(0));
+  EXPECT_GT((f.camera().position - camera_before).norm(), 0);
+  EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
 }
 
 TEST(Filter, RemovingPointsKeepsTheRestOfTheCovariance) {
@@ -233,7 +267,7 @@ RunResult SimulateRun(std::mt19937& rng, double pixel_sigma, double velocity_sig
   Matrix12d p0 = SmallCovariance();
   p0.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * velocity_sigma * velocity_sigma;
   Filter f(truth, p0);
-  const int r = f.AddReference();
+  const int r = f.AddReference(false);
   std::map<int, Eigen::Vector3d> world_point;
   for (int k = 0; k < 40; ++k) {
     const Eigen::Vector2d pixel(20 + 280 * u(rng), 20 + 200 * u(rng));
@@ -303,7 +337,7 @@ TEST(Filter, PlaneConvergesToTheTruthFromFrontoParallel) {
   Matrix12d p0 = SmallCovariance();
   p0.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() * 1e-4;
   Filter f(truth, p0);
-  const int r = f.AddReference();
+  const int r = f.AddReference(false);
   std::vector<Eigen::Vector3d> rays;
   for (int y = 40; y < 220; y += 36) {
     for (int x = 180; x < 310; x += 26) rays.push_back(kCamera.Ray({x, y}));

@@ -25,14 +25,18 @@ void Filter::Predict(double dt, const MotionNoise& noise) {
   }
 }
 
-int Filter::AddReference() {
+int Filter::AddReference(bool fixed) {
   const int n = size();
-  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(n + 6, n + 6);
-  p.topLeftCorner(n, n) = covariance_;
-  p.bottomRows(6).leftCols(n) = covariance_.topRows(6);  // the camera pose's rows: (dp, dtheta)
-  p.rightCols(6).topRows(n) = covariance_.leftCols(6);
-  p.bottomRightCorner(6, 6) = covariance_.topLeftCorner(6, 6);
-  covariance_ = std::move(p);
+  if (fixed) {
+    Augment(Eigen::VectorXd::Zero(6));
+  } else {
+    Eigen::MatrixXd p = Eigen::MatrixXd::Zero(n + 6, n + 6);
+    p.topLeftCorner(n, n) = covariance_;
+    p.bottomRows(6).leftCols(n) = covariance_.topRows(6);  // the camera pose's rows: (dp, dtheta)
+    p.rightCols(6).topRows(n) = covariance_.leftCols(6);
+    p.bottomRightCorner(6, 6) = covariance_.topLeftCorner(6, 6);
+    covariance_ = std::move(p);
+  }
   const int id = next_id_++;
   references_[id] = {camera_.world_from_cam(), n, 0};
   return id;

@@ -351,7 +351,7 @@ struct Odometry::Impl {
     if (found.empty()) return false;
     const Priors converged = priors ? *priors : ConvergedInView();
 
-    const int reference = filter->AddReference();
+    const int reference = filter->AddReference(o.fixed_references);
     Keyframe& keyframe = keyframes[reference];
     keyframe.grey = grey.clone();
     keyframe.time = timestamp;

@@ -60,8 +60,11 @@ class Filter {
   // Constant velocity over dt seconds (PredictCamera), with its process noise.
   void Predict(double dt, const MotionNoise& noise);
 
-  // A reference camera at the current camera's pose (its covariance and correlations are the camera pose's).
-  int AddReference();
+  // A reference camera at the current camera's pose. Tracked (fixed = false): it takes the camera pose's
+  // covariance and correlations, and later updates move it with the camera. Fixed: the pose is taken as exact
+  // (no variance, no correlation), so no update moves it: the map's frame is fixed again at each keyframe, as
+  // the first camera's is at the start. See VoOptions::fixed_references for why.
+  int AddReference(bool fixed);
   // A point on the ray (unit, reference frame) at inverse depth rho with standard deviation sigma_rho,
   // uncorrelated with the rest of the state.
   int AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho);
