@@ -60,7 +60,9 @@ int main(int argc, char** argv) {
   pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, vo_options);
   int keyframes = 0, lost = 0, bootstrap = -1;
   double measurements = 0, peak = before, nees_sum = 0, relative_nees_sum = 0;
-  Eigen::Quaterniond key_estimate = Eigen::Quaterniond::Identity(), key_truth = walk.front().world_from_cam.rotation;
+  // The newest keyframe's orientation, estimated and true.
+  Eigen::Quaterniond key_estimate = Eigen::Quaterniond::Identity();
+  Eigen::Quaterniond key_truth = walk.front().world_from_cam.rotation;
   int nees_frames = 0, nees_inside = 0;
   struct Member {  // a plane's point in view, for the purity below
     int frame, plane, keyframe;

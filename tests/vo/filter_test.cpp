@@ -206,7 +206,9 @@ TEST(Filter, FixedReferenceIsNotMovedByUpdates) {
   EXPECT_TRUE(f.covariance().middleRows(12, 6).isZero(0));
   EXPECT_TRUE(f.covariance().middleCols(12, 6).isZero(0));
   std::vector<int> points;
-  for (int k = 0; k < 6; ++k) points.push_back(f.AddPoint(r, kCamera.Ray({60.0 + 40 * k, 80.0 + 15 * k}), 0.25, 0.1));
+  for (int k = 0; k < 6; ++k) {
+    points.push_back(f.AddPoint(r, kCamera.Ray({60.0 + 40 * k, 80.0 + 15 * k}), 0.25, 0.1));
+  }
   std::mt19937 rng(5);
   std::normal_distribution<double> noise(0, 0.5);
   Filter predicted_only = f;

@@ -161,12 +161,12 @@ TEST(Odometry, UsedMatchesAgreeWithTheTruth) {
     return v[static_cast<size_t>(q * (v.size() - 1))];
   };
   ASSERT_GT(used_errors.size(), 500u);
-  // Measured: used 0.34 px median, 0.72 px at the 90th percentile; rejected 3.1 px median. At depth edges 0.53 px
-  // median and 1.17 px at the 80th percentile (0.47 / 1.00 with reference cameras tracked in the state, 0.54 / 2.97
-  // at the 90th percentile with a 2 px RANSAC threshold, 1 px noise and no rejection history). The last tenth at
-  // depth edges (2.8 px at the 90th percentile; 1.9 with tracked references) comes from three or four features at
-  // occlusion corners whose matches move steadily away from their keyframe pixel's surface (up to 13 px after 60
-  // frames) while RANSAC keeps accepting them: they are not judged here.
+  // Measured: used 0.34 px median, 0.72 px at the 90th percentile; rejected 3.1 px median. At depth edges 0.53
+  // px median and 1.17 px at the 80th percentile (0.47 / 1.00 with reference cameras tracked in the state;
+  // 0.54 / 2.97 at the 90th percentile with a 2 px RANSAC threshold, 1 px noise and no rejection history). The
+  // last tenth at depth edges (2.8 px at the 90th percentile; 1.9 with tracked references) comes from three or
+  // four features at occlusion corners whose matches move steadily away from their keyframe pixel's surface
+  // (up to 13 px after 60 frames) while RANSAC keeps accepting them: they are not judged here.
   EXPECT_LT(quantile(used_errors, 0.5), 0.5);
   EXPECT_LT(quantile(used_errors, 0.9), 1.0);
   ASSERT_GT(edge_used_errors.size(), 100u);
