@@ -45,15 +45,15 @@ Eigen::Matrix<double, 3, 4> Rigid3d::ToMatrix3x4() const {
   return m;
 }
 
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d u = svd.matrixU();
+  if ((u * svd.matrixV().transpose()).determinant() < 0) u.col(2) *= -1;
+  return u * svd.matrixV().transpose();
+}
+
 Rigid3d Rigid3d::FromMatrix3x4(const Eigen::Matrix<double, 3, 4>& m) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m.leftCols<3>(), Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d r = svd.matrixU() * svd.matrixV().transpose();
-  if (r.determinant() < 0) {
-    Eigen::Matrix3d u = svd.matrixU();
-    u.col(2) *= -1;
-    r = u * svd.matrixV().transpose();
-  }
-  return Rigid3d(Eigen::Quaterniond(r), m.col(3));
+  return Rigid3d(Eigen::Quaterniond(NearestRotation(m.leftCols<3>())), m.col(3));
 }
 
 Rigid3d ExpSE3(const Vector6d& xi) {

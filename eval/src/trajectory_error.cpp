@@ -1,7 +1,6 @@
 #include "pdvo/eval/trajectory_error.h"
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 
@@ -113,10 +112,7 @@ AteResult ComputeAte(const Trajectory& gt, const Trajectory& est, Alignment alig
       sum += gt[g].world_from_cam.rotation.toRotationMatrix() *
              est[e].world_from_cam.rotation.toRotationMatrix().transpose();
     }
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sum, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
-    flip(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
-    orientation_alignment = Eigen::Quaterniond(svd.matrixU() * flip * svd.matrixV().transpose());
+    orientation_alignment = Eigen::Quaterniond(NearestRotation(sum));
   }
   std::vector<double> trans, rot;
   for (const auto& [g, e] : pairs) {

@@ -70,6 +70,21 @@ TEST(Geometry, RigidCompositionAndInverse) {
   }
 }
 
+// The nearest rotation: a rotation scaled or slightly perturbed comes back, a reflection becomes a proper
+// rotation, and a sum of rotations about one axis gives the rotation by their mean angle.
+TEST(Geometry, NearestRotation) {
+  const Eigen::Matrix3d r = ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5)).toRotationMatrix();
+  EXPECT_LT((NearestRotation(2.5 * r) - r).cwiseAbs().maxCoeff(), 1e-12);
+  Eigen::Matrix3d perturbed = r;
+  perturbed(0, 1) += 1e-3;
+  EXPECT_LT((NearestRotation(perturbed) - r).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_NEAR(NearestRotation(-Eigen::Matrix3d::Identity()).determinant(), 1.0, 1e-12);
+  const Eigen::Matrix3d sum = ExpSO3(Eigen::Vector3d(0, 0, 0.1)).toRotationMatrix() +
+                              ExpSO3(Eigen::Vector3d(0, 0, 0.3)).toRotationMatrix();
+  EXPECT_LT((NearestRotation(sum) - ExpSO3(Eigen::Vector3d(0, 0, 0.2)).toRotationMatrix()).cwiseAbs().maxCoeff(),
+            1e-12);
+}
+
 TEST(Geometry, AngularDistanceOfAKnownRotation) {
   const Eigen::Quaterniond a = ExpSO3(Eigen::Vector3d(0.1, 0.2, 0.3));
   const Eigen::Quaterniond b = a * ExpSO3(Eigen::Vector3d(0, 0.25, 0));

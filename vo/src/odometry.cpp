@@ -142,11 +142,12 @@ struct Odometry::Impl {
   // scenes are a few metres deep). The poses of the frames in between are replaced by the poses that fit the
   // triangulated corners (PnP); what the filter had mapped before it is dropped (it is at the former scale),
   // while the planes it recorded stay counted. Without enough parallax after bootstrap_frames (e.g. a camera
-  // that only rotates) the filter simply goes on. Known weakness: the frame-to-frame tracks drift, which adds
-  // parallax, so far corners come out too near (on the odometry test's street the priors are 24% nearer than the motion's
-  // scale says, and the filter settles to another scale after the bootstrap). Tracking from the first frame with
-  // each corner's own triangulation uncertainty removes that bias but measured worse over 1,000 frames (streets
-  // 31-54: 0.92 against 0.71%; 101-124: 1.45 against 0.77%), so it is not used.
+  // that only rotates) the filter simply goes on. Known weaknesses: the frame-to-frame tracks drift, which adds
+  // parallax, so far corners come out too near (on the odometry test's street the priors are 24% nearer than
+  // the motion's scale says, and the filter settles to another scale after the bootstrap); tracking from the
+  // first frame with each corner's own triangulation uncertainty removes that bias but measured worse over 1,000
+  // frames (streets 31-54: 0.92 against 0.71%; 101-124: 1.45 against 0.77%), so it is not used. And nearly pure
+  // forward motion can give an essential matrix of sideways motion (README.md).
   static constexpr int kBootstrapCorners = 200;
   static constexpr size_t kBootstrapInliers = 30;
   struct Bootstrap {

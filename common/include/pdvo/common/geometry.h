@@ -23,6 +23,10 @@ Eigen::Vector3d LogSO3(const Eigen::Quaterniond& q);
 // The left Jacobian of SO(3) at phi, used by the SE(3) maps.
 Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& phi);
 
+// The rotation nearest to `m` in the Frobenius norm (SVD, determinant +1): re-orthonormalises a noisy rotation
+// matrix, and of a sum of rotation matrices gives their chordal mean.
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m);
+
 // A rigid transform x -> rotation * x + translation.
 struct Rigid3d {
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
