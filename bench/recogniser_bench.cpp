@@ -1,6 +1,7 @@
 // Recogniser kernels on one core (google-benchmark): describing a 320x240 synthetic street frame (salient points,
-// gradient and colour descriptors, words), the same points described by OpenCV's SIFT as a baseline, and
-// recognising one 100x100 region of a described frame. Model: argv --model=PATH (default models/default).
+// gradient and colour descriptors, words, straight edges), its straight edges alone, the same points described by
+// OpenCV's SIFT as a baseline, and recognising one 100x100 region of a described frame. Model: argv
+// --model=PATH (default models/default).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -45,6 +46,14 @@ void BM_DescriptorsOnly(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(pdvo::ExtractFeatures(image, Model().model().options.features));
 }
 BENCHMARK(BM_DescriptorsOnly)->Unit(benchmark::kMillisecond);
+
+// The straight edges and the vertical for the vanishing-direction cue (part of BM_DescribeFrame).
+void BM_EdgePlanes(benchmark::State& state) {
+  const cv::Mat image = StreetFrame();
+  const pdvo::VanishingOptions& options = Model().model().options.vanishing;
+  for (auto _ : state) benchmark::DoNotOptimize(pdvo::FindEdgePlanes(image, std::nullopt, options));
+}
+BENCHMARK(BM_EdgePlanes)->Unit(benchmark::kMillisecond);
 
 // Baseline: OpenCV's SIFT descriptors at the same points (upright, one size), without our colour descriptor.
 void BM_OpenCvSiftAtTheSamePoints(benchmark::State& state) {

@@ -71,6 +71,7 @@ bool RecogniserOptions::Check() const {
   PDVO_CHECK_OPTION(features.Check());
   PDVO_CHECK_OPTION(min_points >= 1);
   PDVO_CHECK_OPTION(topic_iterations >= 1);
+  PDVO_CHECK_OPTION(vanishing.Check());
   return true;
 }
 

@@ -95,6 +95,7 @@ Eigen::VectorXd LayoutFeature(const RegionWords& r) {
         mass[f] > 0 ? Eigen::Vector3d(normal_matrix[f].ldlt().solve(moment[f])) : Eigen::Vector3d::Zero();
   }
   out[10] = mass[0] + mass[1] > 0 ? mass[0] / (mass[0] + mass[1]) : 0.5;
+  out.tail<2>() = r.edge_structure;
   return out;
 }
 
@@ -129,7 +130,12 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
   PDVO_THROW_CHECK(image.cols == a.annotation.image_width && image.rows == a.annotation.image_height, FormatError,
                    image_path << ": image is " << image.cols << "x" << image.rows << ", its annotation says "
                               << a.annotation.image_width << "x" << a.annotation.image_height);
-  a.image = ToWorkingSize(image, working_width);
+  double scale = 1;
+  a.image = ToWorkingSize(image, working_width, &scale);
+  if (a.annotation.camera) {  // pixel centres map to pixel centres
+    const AnnotationCamera& k = *a.annotation.camera;
+    a.camera = Intrinsics{k.fx * scale, (k.cx + 0.5) * scale - 0.5, (k.cy + 0.5) * scale - 0.5};
+  }
   return a;
 }
 
@@ -142,9 +148,11 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
 
-ImageWords Recogniser::Describe(const cv::Mat& image) const {
-  return QuantiseFeatures(ExtractFeatures(image, model_.options.features), model_.gradient_words,
-                          model_.colour_words);
+ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Intrinsics>& camera) const {
+  const RecogniserOptions& o = model_.options;
+  ImageWords words = QuantiseFeatures(ExtractFeatures(image, o.features), model_.gradient_words, model_.colour_words);
+  words.edges = FindEdgePlanes(image, camera, o.vanishing);
+  return words;
 }
 
 RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
@@ -161,9 +169,13 @@ RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
 
 RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& region) const {
   const RecogniserOptions& o = model_.options;
-  const RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());
+  RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());
+  r.edge_structure = EdgeStructure(words.edges, region, o.vanishing);
   RegionPrediction p;
-  if (r.size() >= o.min_points) p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
+  if (r.size() >= o.min_points) {
+    p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
+    p.normal = FuseNormal(p.normal, words.edges, region, o.vanishing);
+  }
   p.points = r.size();
   return p;
 }

@@ -278,6 +278,23 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   EXPECT_EQ(regions, overall["regions"].get<int>());
   ASSERT_GT(normals, 0);
   EXPECT_NEAR(error_sum / normals, overall["normal_error_deg"]["mean"].get<double>(), 1e-6);
+
+  // The same model without the vanishing-direction fusion (the option edited in the file): the same regions and
+  // plane probabilities, and normals further from the truth.
+  std::string text = ReadFile(dir / "m.yml");
+  const size_t fuse = text.find("fuse_normals: true");
+  ASSERT_NE(fuse, std::string::npos);
+  text.replace(fuse, 18, "fuse_normals: false");
+  WriteFileAtomically(dir / "unfused.yml", text);
+  const CommandResult u = Pdvo("evaluate -m " + (dir / "unfused.yml") + " -a " + (dir / "test/annotations") +
+                                   " --json " + (dir / "unfused.json") + " -v warning",
+                               dir);
+  ASSERT_EQ(u.code, 0) << u.err;
+  const nlohmann::json unfused = nlohmann::json::parse(ReadFile(dir / "unfused.json"))["overall"];
+  EXPECT_EQ(unfused["regions"], overall["regions"]);
+  EXPECT_EQ(unfused["accuracy"], overall["accuracy"]);
+  EXPECT_LT(overall["normal_error_deg"]["mean"].get<double>(), unfused["normal_error_deg"]["mean"].get<double>())
+      << e.out << u.out;
 }
 
 TEST(Cli, TrainAndEvaluateRejectBadInputs) {

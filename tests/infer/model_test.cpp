@@ -94,8 +94,11 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
     return std::string("no error");
   };
   std::string other = text;
-  other.replace(other.find("version: 1"), 10, "version: 7");
-  EXPECT_NE(message_of(other).find("model version 7, this build reads version 1"), std::string::npos)
+  const std::string version = "version: " + std::to_string(kModelVersion);
+  ASSERT_NE(other.find(version), std::string::npos);
+  other.replace(other.find(version), version.size(), "version: 7");
+  EXPECT_NE(message_of(other).find("model version 7, this build reads version " + std::to_string(kModelVersion)),
+            std::string::npos)
       << message_of(other);
   // Cut at a line boundary (valid YAML, no end marker) and in the middle of a matrix.
   const std::string at_line = text.substr(0, text.rfind('\n', text.size() / 2) + 1);

@@ -13,7 +13,7 @@ std::vector<ImageEvaluation> EvaluateRecogniser(const Recogniser& recogniser, co
   Progress progress("evaluating", files.size());
   for (const std::string& file : files) {
     const AnnotatedImage a = ReadAnnotatedImage(file, recogniser.model().options.working_width);
-    const ImageWords words = recogniser.Describe(a.image);
+    const ImageWords words = recogniser.Describe(a.image, a.camera);
     ImageEvaluation row;
     row.annotation_path = file;
     for (const LabelledRegion& r : SampleRegions(a.annotation, a.image.size(), sampling, rng)) {

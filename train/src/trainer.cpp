@@ -25,6 +25,7 @@ struct SampledRegion {
   int image = 0;
   LabelledRegion labelled;
   RegionWords words;
+  Eigen::Vector2d edge_structure;  // found when its image is described (the image's edges are not kept)
 };
 
 // Up to `count` descriptors (gradient or colour) drawn at random from all images, in image order.
@@ -163,8 +164,10 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
     for (size_t i = 0; i < files.size(); ++i) {
       const AnnotatedImage a = ReadAnnotatedImage(files[i], o.recogniser.working_width);
       features.push_back(ExtractFeatures(a.image, o.recogniser.features));
+      const EdgePlanes edges = FindEdgePlanes(a.image, a.camera, o.recogniser.vanishing);
       for (LabelledRegion& r : SampleRegions(a.annotation, a.image.size(), o.regions, rng)) {
-        regions.push_back({static_cast<int>(i), std::move(r), {}});
+        const Eigen::Vector2d structure = EdgeStructure(edges, r.region, o.recogniser.vanishing);
+        regions.push_back({static_cast<int>(i), std::move(r), {}, structure});
       }
       progress.Step();
     }
@@ -195,6 +198,7 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (size_t k = 0; k < regions.size(); ++k) {
     SampledRegion& r = regions[k];
     r.words = CollectRegionWords(words[r.image], r.labelled.region, o.gradient_words, o.colour_words);
+    r.words.edge_structure = r.edge_structure;
     if (r.words.size() < o.recogniser.min_points) continue;
     (r.labelled.planar ? planes : non_planes).push_back(static_cast<int>(k));
     if (r.labelled.planar && r.labelled.normal) normals.push_back(static_cast<int>(k));

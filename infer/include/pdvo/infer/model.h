@@ -1,6 +1,7 @@
 // The plane recogniser's model: everything inference needs, in ONE versioned file (cv::FileStorage YAML):
-// the recogniser options, the two vocabularies, the topic basis, the feature standardisation, the RVM
-// classifier (plane probability) and three RVM regressors (normal components), and a training card.
+// the recogniser options (version 2 added their `vanishing` section and two layout values), the two
+// vocabularies, the topic basis, the feature standardisation, the RVM classifier (plane probability) and three
+// RVM regressors (normal components), and a training card.
 // Writing is atomic; re-writing a read model gives the same bytes. Relevance vectors are stored in single
 // precision (most of the file's bytes; predictions move by about 1e-7 relative), everything else in double.
 #pragma once
@@ -9,13 +10,14 @@
 #include <array>
 #include <string>
 
+#include "pdvo/infer/vanishing.h"
 #include "pdvo/vocab/features.h"
 #include "pdvo/vocab/vocabulary.h"
 
 namespace pdvo {
 
 inline constexpr const char* kModelFormat = "pdvo-plane-model";
-inline constexpr int kModelVersion = 1;
+inline constexpr int kModelVersion = 2;
 
 // A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
 struct RvmFunction {
@@ -33,6 +35,7 @@ struct RecogniserOptions {
   FeatureOptions features;
   int min_points = 8;         // regions with fewer salient points are not recognised
   int topic_iterations = 100; // non-negative projection onto the topics
+  VanishingOptions vanishing; // the edges' vanishing direction, fused with the regressors' normals
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -40,6 +43,7 @@ struct RecogniserOptions {
     visit("features", self.features);
     visit("min_points", self.min_points);
     visit("topic_iterations", self.topic_iterations);
+    visit("vanishing", self.vanishing);
   }
   bool Check() const;
   bool operator==(const RecogniserOptions&) const = default;

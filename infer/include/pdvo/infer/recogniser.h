@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@ struct ImageWords {
   std::vector<float> angle;      // radians in [0, pi), see Features::orientation
   std::vector<float> coherence;  // in [0, 1]
   cv::Size image_size;
+  EdgePlanes edges;              // straight edges (see vanishing.h)
   size_t size() const { return points.size(); }
 };
 
@@ -44,6 +46,7 @@ struct RegionWords {
   cv::Rect2d box;                // the region's extent in pixel-edge coordinates
   cv::Size image_size;
   Eigen::VectorXd histogram;     // gradient words + colour words, sums to 1 (zero if no points)
+  Eigen::Vector2d edge_structure = Eigen::Vector2d::Zero();  // see EdgeStructure; filled by the caller
   int size() const { return static_cast<int>(points.size()); }
 };
 RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words, int colour_words);
@@ -55,8 +58,8 @@ RegionWords CollectRegionWords(const ImageWords& words, const Region& region, in
 // squared) least-squares plane angle = a + b dx + c dy over the points, dx, dy from the region's centre.
 // Lengths are in image widths. Values: the centre from the image centre (2), width and height (2), (a, b, c)
 // of the near-horizontal edges and of the near-vertical ones (3 + 3, zero without such edges), and the near-
-// horizontal family's share of the weight (1).
-inline constexpr int kLayoutDims = 11;
+// horizontal family's share of the weight (1), and the region's edge structure (2, see EdgeStructure).
+inline constexpr int kLayoutDims = 13;
 Eigen::VectorXd LayoutFeature(const RegionWords& region);
 
 // The feature vector of a region (not standardised): the spatiogram of its topics (6 values per topic), then
@@ -72,6 +75,7 @@ struct AnnotatedImage {
   std::string annotation_path;
   Annotation annotation;
   cv::Mat image;  // 8-bit BGR, working size
+  std::optional<Intrinsics> camera;  // at the working size, when the annotation gives one
 };
 // Reads, validates and resizes; throws pdvo::Error naming the file at fault (JSON or image).
 AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int working_width);
@@ -88,10 +92,12 @@ class Recogniser {
   explicit Recogniser(PlaneModel model);
   const PlaneModel& model() const { return model_; }
 
-  // Points and words of an image already at the working size (see ToWorkingSize).
-  ImageWords Describe(const cv::Mat& image) const;
+  // Points, words and edges of an image already at the working size (see ToWorkingSize). Without `camera`,
+  // a pinhole with the options' nominal field of view.
+  ImageWords Describe(const cv::Mat& image, const std::optional<Intrinsics>& camera = std::nullopt) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
-  // The same from a region's (not standardised) feature vector.
+  // The same from a region's (not standardised) feature vector, without the fusion with the region's edges
+  // (FuseNormal in vanishing.h), which needs the image.
   RegionPrediction Predict(const Eigen::VectorXd& feature) const;
 
  private:

@@ -1,0 +1,106 @@
+// The geometric cue to a vertical plane's orientation: where its horizontal edges vanish.
+//
+// Lines of one 3D direction d meet in the image at d's vanishing point, so the plane through the camera
+// centre and any one of them has a normal m with m . d = 0. A straight edge at a pixel therefore constrains
+// the direction of the 3D line it lies on. An image's coherent edges are found with the structure tensor; the
+// near-vertical ones give the vertical direction (their planes all contain it). In a region, the remaining
+// edges vote for the direction d = cos(phi) e1 + sin(phi) e2 of horizontal lines (e1, e2 spanning the
+// horizontal plane), each with the robust (Cauchy) likelihood of its residual m . d. On a vertical plane, its
+// normal is d x up. Edges near the horizon fit every phi and weigh nothing; edges that are not horizontal in
+// 3D are outliers, bounded by the robust loss.
+//
+// The learned normal and this likelihood are fused per region (FuseNormal): planes the model calls
+// horizontal snap to the vertical; for the others, phi maximises the model's prior (a von Mises density in 2
+// phi about the model's own azimuth) plus the edges' mean log-likelihood. This assumes an upright
+// man-made scene: planes are either horizontal or vertical. See models/README.md for what it gives.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+#include "pdvo/annotations/regions.h"
+
+namespace pdvo {
+
+struct VanishingOptions {
+  bool fuse_normals = true;         // false: normals are the regressors' alone
+  double field_of_view_deg = 60;    // horizontal field of view when the camera is not known
+  double tensor_sigma = 1.5;        // px, the structure tensor's Gaussian window
+  double min_strength = 5;          // an edge's gradient, grey levels per pixel (the tensor's larger root)
+  double min_coherence = 0.4;       // ((l1 - l2) / (l1 + l2))^2 of the tensor's eigenvalues
+  double vertical_band_deg = 30;    // edges within this of the vertical direction's plane: vertical lines
+  double max_tilt_deg = 25;         // the vertical found must be this close to the image's y axis
+  int min_edges = 20;               // per region (and 2.5x this per image for the vertical)
+  int max_edges = 2000;             // per region: more are subsampled evenly
+  double residual_scale = 0.4;      // Cauchy scale of m . d
+  double prior_weight = 0.1;        // the model's von Mises concentration, against the mean log-likelihood
+  double horizontal_cos = 0.85;     // |n . up| of the model's normal above this: a horizontal plane
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("fuse_normals", self.fuse_normals);
+    visit("field_of_view_deg", self.field_of_view_deg);
+    visit("tensor_sigma", self.tensor_sigma);
+    visit("min_strength", self.min_strength);
+    visit("min_coherence", self.min_coherence);
+    visit("vertical_band_deg", self.vertical_band_deg);
+    visit("max_tilt_deg", self.max_tilt_deg);
+    visit("min_edges", self.min_edges);
+    visit("max_edges", self.max_edges);
+    visit("residual_scale", self.residual_scale);
+    visit("prior_weight", self.prior_weight);
+    visit("horizontal_cos", self.horizontal_cos);
+  }
+  bool Check() const;
+  bool operator==(const VanishingOptions&) const = default;
+};
+
+// Pinhole intrinsics of the working image (no distortion; square pixels: f is fx).
+struct Intrinsics {
+  double f = 0, cx = 0, cy = 0;
+  // From a horizontal field of view, the principal point at the image's centre.
+  static Intrinsics FromFieldOfView(cv::Size size, double field_of_view_deg);
+};
+
+// An image's coherent edges as the unit normals of their lines' planes through the camera centre.
+struct EdgePlanes {
+  cv::Mat normals;                           // CV_32FC3, image-sized; zero where there is no coherent edge
+  cv::Mat strength;                          // CV_32F, the edge's gradient (zero where none)
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the vertical in the camera frame (y down: pointing down)
+  bool up_found = false;                     // false: too few vertical edges, or a tilt above max_tilt_deg
+};
+// `image`: 8-bit grey or BGR. Without `camera`, a pinhole with the options' nominal field of view.
+EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>& camera,
+                          const VanishingOptions& options);
+
+// A region's edges as constraints on the direction phi of horizontal lines, d(phi) = cos(phi) e1 + sin(phi) e2
+// with phi in [0, pi): each edge's (m . e1, m . e2) and weight (its strength). Empty when the image has no
+// vertical or the region has fewer than min_edges edges off the vertical band.
+struct AzimuthLikelihood {
+  Eigen::Vector3d up, e1, e2;
+  std::vector<Eigen::Vector2f> constraints;
+  std::vector<float> weights;
+  double residual_scale = 1;
+  bool empty() const { return constraints.empty(); }
+  // The weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)): at most 0.
+  double MeanLogLikelihood(double phi) const;
+  // The unit normal of the vertical plane whose horizontal lines run along d(phi), on the side of `towards`.
+  Eigen::Vector3d Normal(double phi, const Eigen::Vector3d& towards) const;
+  // The phi of the vertical plane nearest to the plane with normal n (n not vertical).
+  double Phi(const Eigen::Vector3d& n) const;
+};
+AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region,
+                                          const VanishingOptions& options);
+
+// How much of a region lies on straight edges, a cue to man-made planes: the share of its pixels on coherent
+// edges, and the share of their strength on vertical lines (within vertical_band_deg of the vertical's plane).
+// Zero for a region without pixels or edges.
+Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, const VanishingOptions& options);
+
+// The fused normal (see the top of this file); `model_normal` unit, camera frame, towards the camera.
+Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
+                           const VanishingOptions& options);
+
+}  // namespace pdvo
