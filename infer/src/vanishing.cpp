@@ -108,6 +108,8 @@ EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>&
   return e;
 }
 
+namespace {
+
 // Calls visit(m, strength) for each edge pixel of the region.
 template <class Visit>
 void ForEachEdge(const EdgePlanes& edges, const Region& region, Visit visit) {
@@ -115,13 +117,15 @@ void ForEachEdge(const EdgePlanes& edges, const Region& region, Visit visit) {
   for (int y = box.y; y < box.y + box.height; ++y) {
     const cv::Vec3f* normal = edges.normals.ptr<cv::Vec3f>(y);
     const float* strength = edges.strength.ptr<float>(y);
-    const uchar* inside = region.mask.empty() ? nullptr : region.mask.ptr<uchar>(y - region.box.y) - region.box.x;
+    const uchar* mask_row = region.mask.empty() ? nullptr : region.mask.ptr<uchar>(y - region.box.y);
     for (int x = box.x; x < box.x + box.width; ++x) {
-      if (strength[x] <= 0 || (inside && !inside[x])) continue;
+      if (strength[x] <= 0 || (mask_row && !mask_row[x - region.box.x])) continue;
       visit(Eigen::Vector3f(normal[x][0], normal[x][1], normal[x][2]), strength[x]);
     }
   }
 }
+
+}  // namespace
 
 Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, const VanishingOptions& o) {
   const double area = region.Area();

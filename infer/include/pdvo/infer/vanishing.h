@@ -30,7 +30,9 @@ struct VanishingOptions {
   double tensor_sigma = 1.5;        // px, the structure tensor's Gaussian window
   double min_strength = 5;          // an edge's gradient, grey levels per pixel (the tensor's larger root)
   double min_coherence = 0.4;       // ((l1 - l2) / (l1 + l2))^2 of the tensor's eigenvalues
-  double vertical_band_deg = 30;    // edges within this of the vertical direction's plane: vertical lines
+  // Vertical edges: within this angle of the image's y axis when the vertical is found; in a region, those whose
+  // line's plane is within this angle of containing the vertical (they say nothing of the azimuth).
+  double vertical_band_deg = 30;
   double max_tilt_deg = 25;         // the vertical found must be this close to the image's y axis
   int min_edges = 20;               // per region (and 2.5x this per image for the vertical)
   int max_edges = 2000;             // per region: more are subsampled evenly
@@ -88,15 +90,15 @@ struct AzimuthLikelihood {
   double MeanLogLikelihood(double phi) const;
   // The unit normal of the vertical plane whose horizontal lines run along d(phi), on the side of `towards`.
   Eigen::Vector3d Normal(double phi, const Eigen::Vector3d& towards) const;
-  // The phi of the vertical plane nearest to the plane with normal n (n not vertical).
+  // The phi of the vertical plane nearest to the plane with normal n (n not along the vertical).
   double Phi(const Eigen::Vector3d& n) const;
 };
 AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region,
                                           const VanishingOptions& options);
 
 // How much of a region lies on straight edges, a cue to man-made planes: the share of its pixels on coherent
-// edges, and the share of their strength on vertical lines (within vertical_band_deg of the vertical's plane).
-// Zero for a region without pixels or edges.
+// edges, and the share of their strength on vertical lines (see vertical_band_deg; without a vertical found, the
+// image's y axis stands in for it). Zero for a region without pixels or edges.
 Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, const VanishingOptions& options);
 
 // The fused normal (see the top of this file); `model_normal` unit, camera frame, towards the camera.
