@@ -45,6 +45,8 @@ EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>&
   PDVO_THROW_CHECK(!image.empty() && image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3),
                    InvalidArgument, "edge planes: expected an 8-bit grey or BGR image");
   const Intrinsics k = camera.value_or(Intrinsics::FromFieldOfView(image.size(), o.field_of_view_deg));
+  EdgePlanes e;
+  e.camera = k;
   PDVO_THROW_CHECK(k.f > 0 && std::isfinite(k.f) && std::isfinite(k.cx) && std::isfinite(k.cy), InvalidArgument,
                    "edge planes: bad intrinsics (f " << k.f << ", c " << k.cx << ", " << k.cy << ")");
   cv::Mat grey = image;
@@ -57,7 +59,6 @@ EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>&
   cv::Mat xx = gx.mul(gx), xy = gx.mul(gy), yy = gy.mul(gy);
   for (cv::Mat* m : {&xx, &xy, &yy}) cv::GaussianBlur(*m, *m, cv::Size(), o.tensor_sigma);
 
-  EdgePlanes e;
   e.normals = cv::Mat::zeros(image.size(), CV_32FC3);
   e.strength = cv::Mat::zeros(image.size(), CV_32F);
   const double min_strength2 = o.min_strength * o.min_strength, vertical_sin = std::sin(o.vertical_band_deg * kDegree);
@@ -201,8 +202,14 @@ AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region&
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& o) {
   if (!o.fuse_normals || !edges.up_found) return model_normal;
-  const double along_up = model_normal.dot(edges.up);
-  if (std::abs(along_up) > o.horizontal_cos) return along_up > 0 ? edges.up : Eigen::Vector3d(-edges.up);
+  const Intrinsics& k = edges.camera;
+  const Eigen::Vector3d ray((region.box.x + 0.5 * (region.box.width - 1) - k.cx) / k.f,
+                            (region.box.y + 0.5 * (region.box.height - 1) - k.cy) / k.f, 1);
+  // The fused plane is seen, so it faces the camera at the region's centre: a horizontal plane below the
+  // horizon from above, one above it from below; a vertical plane on the side of the ray.
+  if (std::abs(model_normal.dot(edges.up)) > o.horizontal_cos) {
+    return edges.up.dot(ray) < 0 ? edges.up : Eigen::Vector3d(-edges.up);
+  }
   const AzimuthLikelihood l = RegionAzimuthLikelihood(edges, region, o);
   if (l.empty()) return model_normal;
   const double prior_phi = l.Phi(model_normal);
@@ -218,7 +225,7 @@ Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes
   for (int i = 0; i < kCoarseSteps; ++i) consider((i + 0.5) * coarse);
   const double centre = best_phi;
   for (double step = -coarse / 2; step <= coarse / 2 + 1e-9; step += kDegree) consider(centre + step);
-  return l.Normal(best_phi, model_normal);
+  return l.Normal(best_phi, -ray);
 }
 
 }  // namespace pdvo

@@ -174,7 +174,10 @@ TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
     const double p = o.prior_weight * std::cos(2 * (phi - prior_phi)) + l.MeanLogLikelihood(phi);
     if (p > best) best = p, best_phi = phi;
   }
-  EXPECT_LT(AngleDeg(fused, l.Normal(best_phi, model)), 0.6);
+  const Eigen::Vector3d ray((s.region.box.x + 0.5 * (s.region.box.width - 1) - kCamera.cx) / kCamera.f,
+                            (s.region.box.y + 0.5 * (s.region.box.height - 1) - kCamera.cy) / kCamera.f, 1);
+  EXPECT_LT(AngleDeg(fused, l.Normal(best_phi, -ray)), 0.6);
+  EXPECT_LT(fused.dot(ray), 0);
   // The prior pulls towards the model, the edges to the plane: much nearer the plane.
   EXPECT_LT(AngleDeg(fused, s.normal), AngleDeg(model, s.normal) / 3);
   // A strong prior keeps the model's azimuth (within the width of the likelihood's peak): a prior of 100
@@ -184,6 +187,8 @@ TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
   const Eigen::Vector3d kept = FuseNormal(model, e, s.region, stubborn);
   EXPECT_GT(AngleDeg(kept, s.normal), 20);
   EXPECT_NEAR(kept.dot(e.up), 0, 1e-9);  // still snapped to a vertical plane
+  // The fused plane faces the camera whichever way the model's normal points.
+  EXPECT_LT(AngleDeg(FuseNormal(-model, e, s.region, o), fused), 1e-9);
   // Disabled: the model's normal as it is.
   VanishingOptions off;
   off.fuse_normals = false;
@@ -195,8 +200,13 @@ TEST(Vanishing, HorizontalPlanesSnapToTheVertical) {
   const EdgePlanes e = FindEdgePlanes(s.image, kCamera, VanishingOptions());
   const Eigen::Vector3d ground_like = (-e.up + Eigen::Vector3d(0.2, 0, -0.3)).normalized();  // about 20 deg off -up
   ASSERT_GT(std::abs(ground_like.dot(e.up)), VanishingOptions().horizontal_cos);
-  EXPECT_EQ(FuseNormal(ground_like, e, s.region, VanishingOptions()), -e.up);
-  EXPECT_EQ(FuseNormal(-ground_like, e, s.region, VanishingOptions()), e.up);
+  // Below the horizon a horizontal plane is seen from above (a floor), above it from below (a ceiling): the
+  // side that faces the camera, whichever way the model's normal points.
+  const Region floor{cv::Rect(100, 200, 60, 30), cv::Mat()}, ceiling{cv::Rect(100, 5, 60, 30), cv::Mat()};
+  for (const Eigen::Vector3d& model : {ground_like, Eigen::Vector3d(-ground_like)}) {
+    EXPECT_EQ(FuseNormal(model, e, floor, VanishingOptions()), -e.up);
+    EXPECT_EQ(FuseNormal(model, e, ceiling, VanishingOptions()), e.up);
+  }
 }
 
 TEST(Vanishing, WithoutEdgesTheModelsNormalStays) {

@@ -9,9 +9,9 @@
 // normal is d x up. Edges near the horizon fit every phi and weigh nothing; edges that are not horizontal in
 // 3D are outliers, bounded by the robust loss.
 //
-// The learned normal and this likelihood are fused per region (FuseNormal): planes the model calls
-// horizontal snap to the vertical; for the others, phi maximises the model's prior (a von Mises density in 2
-// phi about the model's own azimuth) plus the edges' mean log-likelihood. This assumes an upright
+// The learned normal and this likelihood are fused per region (FuseNormal): planes the model calls horizontal
+// snap to the vertical; for the others, phi maximises the model's prior (a von Mises density in 2 phi about the
+// model's own azimuth) plus the edges' mean log-likelihood; either faces the camera. This assumes an upright
 // man-made scene: planes are either horizontal or vertical. See models/README.md for what it gives.
 #pragma once
 
@@ -68,6 +68,7 @@ struct Intrinsics {
 
 // An image's coherent edges as the unit normals of their lines' planes through the camera centre.
 struct EdgePlanes {
+  Intrinsics camera;                         // the camera the planes were found with
   cv::Mat normals;                           // CV_32FC3, image-sized; zero where there is no coherent edge
   cv::Mat strength;                          // CV_32F, the edge's gradient (zero where none)
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the vertical in the camera frame (y down: pointing down)
@@ -101,7 +102,8 @@ AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region&
 // image's y axis stands in for it). Zero for a region without pixels or edges.
 Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, const VanishingOptions& options);
 
-// The fused normal (see the top of this file); `model_normal` unit, camera frame, towards the camera.
+// The fused normal (see the top of this file); `model_normal` unit, camera frame. The fused normal faces the
+// camera at the region's centre (the ray through it, from the edges' camera), as a visible plane does.
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& options);
 
