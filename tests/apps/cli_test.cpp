@@ -280,7 +280,7 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   EXPECT_NEAR(error_sum / normals, overall["normal_error_deg"]["mean"].get<double>(), 1e-6);
 
   // The same model without the vanishing-direction fusion (the option edited in the file): the same regions and
-  // plane probabilities, and normals further from the truth.
+  // accuracy (the fusion leaves the classifier alone), and normals further from the truth.
   std::string text = ReadFile(dir / "m.yml");
   const size_t fuse = text.find("fuse_normals: true");
   ASSERT_NE(fuse, std::string::npos);
