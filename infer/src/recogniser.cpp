@@ -130,11 +130,13 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
   PDVO_THROW_CHECK(image.cols == a.annotation.image_width && image.rows == a.annotation.image_height, FormatError,
                    image_path << ": image is " << image.cols << "x" << image.rows << ", its annotation says "
                               << a.annotation.image_width << "x" << a.annotation.image_height);
-  double scale = 1;
-  a.image = ToWorkingSize(image, working_width, &scale);
-  if (a.annotation.camera) {  // pixel centres map to pixel centres
+  a.image = ToWorkingSize(image, working_width);
+  if (a.annotation.camera) {
     const AnnotationCamera& k = *a.annotation.camera;
-    a.camera = Intrinsics{k.fx * scale, (k.cx + 0.5) * scale - 0.5, (k.cy + 0.5) * scale - 0.5};
+    Camera full;
+    full.width = image.cols, full.height = image.rows;
+    full.fx = k.fx, full.fy = k.fy, full.cx = k.cx, full.cy = k.cy;
+    a.camera = full.Rescaled(a.image.cols, a.image.rows);
   }
   return a;
 }
@@ -148,7 +150,7 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
 
-ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Intrinsics>& camera) const {
+ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera>& camera) const {
   const RecogniserOptions& o = model_.options;
   ImageWords words = QuantiseFeatures(ExtractFeatures(image, o.features), model_.gradient_words, model_.colour_words);
   words.edges = FindEdgePlanes(image, camera, o.vanishing);

@@ -36,19 +36,27 @@ bool VanishingOptions::Check() const {
   return true;
 }
 
-Intrinsics Intrinsics::FromFieldOfView(cv::Size size, double field_of_view_deg) {
-  return {0.5 * size.width / std::tan(0.5 * field_of_view_deg * kDegree), (size.width - 1) / 2.0,
-          (size.height - 1) / 2.0};
+Camera NominalCamera(cv::Size size, double field_of_view_deg) {
+  Camera c;
+  c.width = size.width;
+  c.height = size.height;
+  c.fx = c.fy = 0.5 * size.width / std::tan(0.5 * field_of_view_deg * kDegree);
+  c.cx = (size.width - 1) / 2.0;
+  c.cy = (size.height - 1) / 2.0;
+  return c;
 }
 
-EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>& camera, const VanishingOptions& o) {
+EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& camera, const VanishingOptions& o) {
   PDVO_THROW_CHECK(!image.empty() && image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3),
                    InvalidArgument, "edge planes: expected an 8-bit grey or BGR image");
-  const Intrinsics k = camera.value_or(Intrinsics::FromFieldOfView(image.size(), o.field_of_view_deg));
+  const Camera k = camera.value_or(NominalCamera(image.size(), o.field_of_view_deg));
+  k.Check("edge planes");
+  PDVO_THROW_CHECK(!k.HasDistortion() && k.width == image.cols && k.height == image.rows, InvalidArgument,
+                   "edge planes: the camera (" << k.width << "x" << k.height << (k.HasDistortion() ? ", distorted" : "")
+                                               << ") does not fit the " << image.cols << "x" << image.rows
+                                               << " image");
   EdgePlanes e;
   e.camera = k;
-  PDVO_THROW_CHECK(k.f > 0 && std::isfinite(k.f) && std::isfinite(k.cx) && std::isfinite(k.cy), InvalidArgument,
-                   "edge planes: bad intrinsics (f " << k.f << ", c " << k.cx << ", " << k.cy << ")");
   cv::Mat grey = image;
   if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   // Scharr's derivatives (in grey levels per pixel): Sobel's pull the orientation of near-axis edges towards the
@@ -81,7 +89,7 @@ EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>&
       const double ex = -std::copysign(std::sqrt(std::max(0.0, 0.5 * (1 - cos2))), b[x]);
       // The image line through (x, y) along (ex, ey), and the normal of its plane through the camera: K^T l.
       const double l0 = -ey, l1 = ex, l2 = x * ey - y * ex;
-      const Eigen::Vector3d m = Eigen::Vector3d(k.f * l0, k.f * l1, k.cx * l0 + k.cy * l1 + l2).normalized();
+      const Eigen::Vector3d m = Eigen::Vector3d(k.fx * l0, k.fy * l1, k.cx * l0 + k.cy * l1 + l2).normalized();
       normal[x] = cv::Vec3f(m.x(), m.y(), m.z());
       strength[x] = static_cast<float>(std::sqrt(larger));
       if (std::abs(ex) < vertical_sin) {
@@ -202,9 +210,8 @@ AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region&
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& o) {
   if (!o.fuse_normals || !edges.up_found) return model_normal;
-  const Intrinsics& k = edges.camera;
-  const Eigen::Vector3d ray((region.box.x + 0.5 * (region.box.width - 1) - k.cx) / k.f,
-                            (region.box.y + 0.5 * (region.box.height - 1) - k.cy) / k.f, 1);
+  const Eigen::Vector3d ray = edges.camera.Unproject(
+      {region.box.x + 0.5 * (region.box.width - 1), region.box.y + 0.5 * (region.box.height - 1)});
   // The fused plane is seen, so it faces the camera at the region's centre: a horizontal plane below the
   // horizon from above, one above it from below; a vertical plane on the side of the ray.
   if (std::abs(model_normal.dot(edges.up)) > o.horizontal_cos) {

@@ -75,7 +75,7 @@ struct AnnotatedImage {
   std::string annotation_path;
   Annotation annotation;
   cv::Mat image;  // 8-bit BGR, working size
-  std::optional<Intrinsics> camera;  // at the working size, when the annotation gives one
+  std::optional<Camera> camera;  // at the working size, when the annotation gives one
 };
 // Reads, validates and resizes; throws pdvo::Error naming the file at fault (JSON or image).
 AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int working_width);
@@ -93,8 +93,8 @@ class Recogniser {
   const PlaneModel& model() const { return model_; }
 
   // Points, words and edges of an image already at the working size (see ToWorkingSize). Without `camera`,
-  // a pinhole with the options' nominal field of view.
-  ImageWords Describe(const cv::Mat& image, const std::optional<Intrinsics>& camera = std::nullopt) const;
+  // NominalCamera with the options' field of view (vanishing.h).
+  ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
   // The same from a region's (not standardised) feature vector, without the fusion with the region's edges
   // (FuseNormal in vanishing.h), which needs the image.

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "pdvo/annotations/regions.h"
+#include "pdvo/common/camera.h"
 
 namespace pdvo {
 
@@ -59,24 +60,22 @@ struct VanishingOptions {
   bool operator==(const VanishingOptions&) const = default;
 };
 
-// Pinhole intrinsics of the working image (no distortion; square pixels: f is fx).
-struct Intrinsics {
-  double f = 0, cx = 0, cy = 0;
-  // From a horizontal field of view, the principal point at the image's centre.
-  static Intrinsics FromFieldOfView(cv::Size size, double field_of_view_deg);
-};
+// A pinhole camera of an image of `size` with the given horizontal field of view, square pixels and the principal
+// point at the image's centre: the camera assumed when an image comes without one.
+Camera NominalCamera(cv::Size size, double field_of_view_deg);
 
 // An image's coherent edges as the unit normals of their lines' planes through the camera centre.
 struct EdgePlanes {
-  Intrinsics camera;                         // the camera the planes were found with
+  Camera camera;                             // the camera the planes were found with
   cv::Mat normals;                           // CV_32FC3, image-sized; zero where there is no coherent edge
   cv::Mat strength;                          // CV_32F, the edge's gradient (zero where none)
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the vertical in the camera frame (y down: pointing down)
   bool up_found = false;                     // false: too few vertical edges, or a tilt above max_tilt_deg
 };
-// `image`: 8-bit grey or BGR. Without `camera`, a pinhole with the options' nominal field of view.
-EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Intrinsics>& camera,
-                          const VanishingOptions& options);
+// `image`: 8-bit grey or BGR. `camera`: the image's, without distortion (an undistorted image's); without one,
+// NominalCamera with the options' field of view. Throws InvalidArgument for another image type, or a camera that
+// fails Camera::Check, has distortion or another image size.
+EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& camera, const VanishingOptions& options);
 
 // A region's edges as constraints on the direction phi of horizontal lines, d(phi) = cos(phi) e1 + sin(phi) e2
 // with phi in [0, pi): each edge's (m . e1, m . e2) and weight (its strength). Empty when the image has no
