@@ -6,6 +6,12 @@
 
 namespace pdvo {
 namespace detail {
+
+std::string& FailedOption() {
+  thread_local std::string failed;
+  return failed;
+}
+
 namespace {
 std::string TypeName(const cv::FileNode& node) {
   if (node.isMap()) return "a map";

@@ -37,7 +37,8 @@ struct OuterOptions {
   }
   bool Check() const {
     PDVO_CHECK_OPTION(threshold >= 0);
-    return inner.Check();
+    PDVO_CHECK_OPTION(inner.Check());
+    return true;
   }
   bool operator==(const OuterOptions&) const = default;
 };
@@ -89,7 +90,22 @@ TEST(Options, WrongTypeIsAnError) {
 TEST(Options, CheckRejectsBadValues) {
   test::TempDir dir;
   WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  iterations: 0\n");
-  EXPECT_THROW(LoadOptions<OuterOptions>(dir / "o.yaml"), InvalidArgument);
+  try {
+    LoadOptions<OuterOptions>(dir / "o.yaml");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    // One message naming the file and the innermost condition that failed, not the outer check of `inner`.
+    EXPECT_EQ(std::string(e.what()), "invalid options in " + (dir / "o.yaml") + ": iterations > 0 does not hold");
+  }
+  // The next check starts afresh: a failure of the outer options names the outer condition.
+  OuterOptions o;
+  o.threshold = -1;
+  try {
+    CheckOptionsOrThrow(o, "outer options");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_EQ(std::string(e.what()), "invalid outer options: threshold >= 0 does not hold");
+  }
 }
 
 TEST(Options, MissingFileIsAnIoError) {

@@ -9,7 +9,7 @@
 //       visit("max_angle_deg", self.max_angle_deg);
 //       visit("bar", self.bar);
 //     }
-//     bool Check() const;           // logs the bad field and returns false (COLMAP's CHECK_OPTION)
+//     bool Check() const;           // records the failed condition and returns false (COLMAP's CHECK_OPTION)
 //     bool operator==(const FooOptions&) const = default;
 //   };
 //
@@ -40,13 +40,19 @@ struct FieldProbe {
 template <class T>
 concept OptionsStruct = requires(T& t, detail::FieldProbe& probe) { T::Fields(t, probe); };
 
-// In a Check(): logs the failed condition and returns false.
-#define PDVO_CHECK_OPTION(cond)                                       \
-  do {                                                                \
-    if (!(cond)) {                                                    \
-      PDVO_LOG(Error) << "invalid option: " << #cond << " is false"; \
-      return false;                                                   \
-    }                                                                 \
+namespace detail {
+// The first condition that failed in a PDVO_CHECK_OPTION since it was last cleared (per thread): the innermost
+// one when Check() calls nested Check()s.
+std::string& FailedOption();
+}  // namespace detail
+
+// In a Check(): records the failed condition (see detail::FailedOption) and returns false.
+#define PDVO_CHECK_OPTION(cond)                                                              \
+  do {                                                                                       \
+    if (!(cond)) {                                                                           \
+      if (::pdvo::detail::FailedOption().empty()) ::pdvo::detail::FailedOption() = #cond; \
+      return false;                                                                          \
+    }                                                                                        \
   } while (false)
 
 namespace detail {
@@ -142,6 +148,14 @@ void ApplyOverrides(T& options, const std::vector<std::string>& assignments) {
 // Opens a YAML file for reading; throws IoError naming the file if it cannot be opened or parsed.
 cv::FileStorage OpenYamlForReading(const std::string& path);
 
+// Throws InvalidArgument if options.Check() fails, naming the options (`what`) and the failed condition.
+template <OptionsStruct T>
+void CheckOptionsOrThrow(const T& options, const std::string& what) {
+  detail::FailedOption().clear();
+  PDVO_THROW_CHECK(options.Check(), InvalidArgument,
+                   "invalid " << what << ": " << detail::FailedOption() << " does not hold");
+}
+
 // Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them.
 template <OptionsStruct T>
 T LoadOptions(const std::string& path, const std::string& section = "") {
@@ -149,7 +163,7 @@ T LoadOptions(const std::string& path, const std::string& section = "") {
   T options;
   ReadOptions(section.empty() ? fs.root() : fs[section], options,
               section.empty() ? path : path + ": " + section);
-  PDVO_THROW_CHECK(options.Check(), InvalidArgument, path << ": invalid options (see the message above)");
+  CheckOptionsOrThrow(options, "options in " + path);
   return options;
 }
 
@@ -161,12 +175,6 @@ void SaveOptions(const std::string& path, const T& options, const std::string& s
   WriteOptions(fs, options);
   fs << "}";
   WriteFileAtomically(path, fs.releaseAndGetString());
-}
-
-// Throws InvalidArgument if options.Check() fails; `what` names the options.
-template <OptionsStruct T>
-void CheckOptionsOrThrow(const T& options, const std::string& what) {
-  PDVO_THROW_CHECK(options.Check(), InvalidArgument, "invalid " << what << " (see the message above)");
 }
 
 }  // namespace pdvo
