@@ -13,7 +13,7 @@ namespace pdvo::apps {
 int RunTrain(int argc, char** argv) {
   CLI::App app("Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
                "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
-               "visual vocabularies, topics, spatiograms, an RVM classifier and RVM normal regressors. Writes one "
+               "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. Writes one "
                "model file (YAML) holding everything inference needs and a training card.",
                "pdvo train");
   std::vector<std::string> inputs, overrides;
@@ -41,11 +41,15 @@ int RunTrain(int argc, char** argv) {
   model.Write(out_path);
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  std::printf("wrote %s: %d images, %d+%d regions, cv accuracy %.3f, cv normal error %.1f deg, relevance vectors "
-              "%d (classifier) %d/%d/%d (normal); peak memory %.0f MiB\n",
+  std::string classifier_sizes;
+  for (const RvmFunction& f : model.classifiers) {
+    classifier_sizes += (classifier_sizes.empty() ? "" : "/") + std::to_string(f.size());
+  }
+  std::printf("wrote %s: %d images, %d+%d regions per classifier, cv accuracy %.3f, cv normal error %.1f deg, "
+              "relevance vectors %s (%zu classifiers) %d/%d/%d (normal); peak memory %.0f MiB\n",
               out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
-              model.card.cv_accuracy, model.card.cv_normal_error, model.classifier.size(), model.normal[0].size(),
-              model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
+              model.card.cv_accuracy, model.card.cv_normal_error, classifier_sizes.c_str(), model.classifiers.size(),
+              model.normal[0].size(), model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
   return 0;
 }
 

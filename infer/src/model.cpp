@@ -37,8 +37,10 @@ Eigen::MatrixXd ReadMatrix(const cv::FileNode& node, const std::string& where, c
   return out;
 }
 
+// `name` empty: an element of a sequence.
 void WriteRvm(cv::FileStorage& fs, const std::string& name, const RvmFunction& f) {
-  fs << name << "{" << "gamma" << f.gamma << "bias" << f.bias << "relevance_vectors" << f.size();
+  if (!name.empty()) fs << name;
+  fs << "{" << "gamma" << f.gamma << "bias" << f.bias << "relevance_vectors" << f.size();
   fs << "weights" << ToMat(f.weights) << "vectors" << ToFloatMat(f.vectors) << "}";
 }
 
@@ -89,7 +91,9 @@ std::string PlaneModel::ToYaml() const {
   colour_words.Write(fs, "colour_words");
   fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale"
      << ToMat(feature_scale);
-  WriteRvm(fs, "classifier", classifier);
+  fs << "classifiers" << "[";
+  for (const RvmFunction& f : classifiers) WriteRvm(fs, "", f);
+  fs << "]";
   WriteRvm(fs, "normal_x", normal[0]);
   WriteRvm(fs, "normal_y", normal[1]);
   WriteRvm(fs, "normal_z", normal[2]);
@@ -140,7 +144,11 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
   PDVO_THROW_CHECK(m.feature_mean.cols() == 1 && m.feature_scale.rows() == dims && m.feature_scale.cols() == 1 &&
                        (m.feature_scale.array() > 0).all(),
                    FormatError, where << ": malformed feature standardisation");
-  m.classifier = ReadRvm(fs["classifier"], where + ": classifier", dims);
+  const cv::FileNode classifiers = fs["classifiers"];
+  PDVO_THROW_CHECK(classifiers.isSeq() && classifiers.size() > 0, FormatError, where << ": no classifiers");
+  for (size_t i = 0; i < classifiers.size(); ++i) {
+    m.classifiers.push_back(ReadRvm(classifiers[static_cast<int>(i)], where + ": classifier " + std::to_string(i), dims));
+  }
   m.normal[0] = ReadRvm(fs["normal_x"], where + ": normal_x", dims);
   m.normal[1] = ReadRvm(fs["normal_y"], where + ": normal_y", dims);
   m.normal[2] = ReadRvm(fs["normal_z"], where + ": normal_z", dims);

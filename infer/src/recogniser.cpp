@@ -1,6 +1,7 @@
 #include "pdvo/infer/recogniser.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
@@ -145,8 +146,10 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
   PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(),
                    InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
   const Eigen::Index dims = RegionFeatureDims(static_cast<int>(model_.topics.cols()));
-  const bool classifier_fits = model_.classifier.size() == 0 || model_.classifier.vectors.cols() == dims;
-  PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifier_fits, InvalidArgument,
+  PDVO_THROW_CHECK(!model_.classifiers.empty(), InvalidArgument, "recogniser: the model has no classifier");
+  const bool classifiers_fit = std::all_of(model_.classifiers.begin(), model_.classifiers.end(),
+                                           [&](const RvmFunction& f) { return f.size() == 0 || f.vectors.cols() == dims; });
+  PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifiers_fit, InvalidArgument,
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
 
@@ -163,7 +166,8 @@ RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
   const Eigen::VectorXd x = (feature - model_.feature_mean).cwiseQuotient(model_.feature_scale);
   RegionPrediction p;
   p.valid = true;
-  p.plane_probability = 1.0 / (1.0 + std::exp(-model_.classifier(x)));
+  for (const RvmFunction& f : model_.classifiers) p.plane_probability += 1.0 / (1.0 + std::exp(-f(x)));
+  p.plane_probability /= static_cast<double>(model_.classifiers.size());
   const Eigen::Vector3d n(model_.normal[0](x), model_.normal[1](x), model_.normal[2](x));
   if (n.norm() > 1e-9) p.normal = n.normalized();
   return p;

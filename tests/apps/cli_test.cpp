@@ -14,6 +14,7 @@
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/common/trajectory.h"
+#include "pdvo/infer/model.h"
 #include "pdvo/test/annotations.h"
 #include "pdvo/test/scenes.h"
 #include "pdvo/test/support.h"
@@ -244,6 +245,13 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   // The same seed gives the same model, byte for byte.
   ASSERT_EQ(Pdvo("train -a " + (dir / "train/annotations") + " -o " + (dir / "m2.yml") + small, dir).code, 0);
   EXPECT_EQ(ReadFile(dir / "m.yml"), ReadFile(dir / "m2.yml"));
+  // The default committee of classifiers, each trained on its own draw of regions.
+  const PlaneModel model = PlaneModel::Read(dir / "m.yml");
+  ASSERT_EQ(model.classifiers.size(), 5u);
+  for (size_t i = 1; i < model.classifiers.size(); ++i) {
+    const RvmFunction &a = model.classifiers[0], &b = model.classifiers[i];
+    EXPECT_FALSE(a.size() == b.size() && a.vectors == b.vectors) << "classifiers 0 and " << i << " are the same";
+  }
 
   const CommandResult e = Pdvo("evaluate -m " + (dir / "m.yml") + " -a " + (dir / "test/annotations") + " --json " +
                                    (dir / "report.json") + " -v warning",
@@ -312,6 +320,7 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   WriteAnnotation(dir / "planes/a.json", a);
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
                "no non-plane regions");
+  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifiers=0", "classifiers >= 1");
   // A missing image.
   a.image_path = "gone.png";
   fs::create_directories(dir / "missing");

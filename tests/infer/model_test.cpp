@@ -37,7 +37,7 @@ PlaneModel RandomModel() {
   const int dims = RegionFeatureDims(3);
   m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
   m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
-  m.classifier = RandomRvm(4, dims, rng);
+  for (int size : {4, 2, 5}) m.classifiers.push_back(RandomRvm(size, dims, rng));
   for (RvmFunction& f : m.normal) f = RandomRvm(3, dims, rng);
   m.card.data = "synthetic streets";
   m.card.images = 7;
@@ -61,8 +61,12 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   const Eigen::VectorXd x = Eigen::VectorXd::NullaryExpr(m.feature_mean.size(), [&]() { return g(rng); });
   // Relevance vectors are stored in single precision: predictions move by a float's rounding; once read, they
   // are what they are.
-  EXPECT_EQ(back.classifier.vectors, m.classifier.vectors.cast<float>().cast<double>());
-  EXPECT_NEAR(back.classifier(x), m.classifier(x), 1e-5 * (1 + std::abs(m.classifier(x))));
+  ASSERT_EQ(back.classifiers.size(), m.classifiers.size());
+  for (size_t i = 0; i < m.classifiers.size(); ++i) {
+    const RvmFunction &f = m.classifiers[i], &read = back.classifiers[i];
+    EXPECT_EQ(read.vectors, f.vectors.cast<float>().cast<double>());
+    EXPECT_NEAR(read(x), f(x), 1e-5 * (1 + std::abs(f(x))));
+  }
   const RegionPrediction a = Recogniser(m).Predict(x), b = Recogniser(back).Predict(x);
   const RegionPrediction c = Recogniser(PlaneModel::FromYaml(back.ToYaml(), "again")).Predict(x);
   EXPECT_NEAR(a.plane_probability, b.plane_probability, 1e-5);
@@ -70,6 +74,25 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_EQ(b.plane_probability, c.plane_probability);
   EXPECT_EQ(b.normal, c.normal);
   EXPECT_NEAR(a.normal.norm(), 1.0, 1e-12);
+}
+
+TEST(Model, PlaneProbabilityIsTheClassifiersMeanProbability) {
+  const PlaneModel m = RandomModel();
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g(0, 1);
+  const Eigen::VectorXd x = Eigen::VectorXd::NullaryExpr(m.feature_mean.size(), [&]() { return g(rng); });
+  const Eigen::VectorXd standardised = (x - m.feature_mean).cwiseQuotient(m.feature_scale);
+  double mean = 0;
+  for (const RvmFunction& f : m.classifiers) mean += 1 / (1 + std::exp(-f(standardised))) / 3;
+  EXPECT_NEAR(Recogniser(m).Predict(x).plane_probability, mean, 1e-12);
+  // One member alone gives its own probability, which differs from the committee's.
+  PlaneModel one = m;
+  one.classifiers.resize(1);
+  const double alone = 1 / (1 + std::exp(-m.classifiers[0](standardised)));
+  EXPECT_NEAR(Recogniser(one).Predict(x).plane_probability, alone, 1e-12);
+  EXPECT_GT(std::abs(alone - mean), 1e-3);
+  one.classifiers.clear();
+  EXPECT_THROW(Recogniser{one}, InvalidArgument);
 }
 
 TEST(Model, RvmFunctionIsTheKernelExpansion) {
@@ -108,6 +131,9 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   EXPECT_NE(message_of("%YAML:1.0\n---\nformat: something-else\n").find("not a pdvo-plane-model"), std::string::npos);
   EXPECT_NE(message_of("not yaml at all: [").find("m.yml"), std::string::npos);
   EXPECT_THROW(PlaneModel::Read("/nonexistent/model.yml"), IoError);
+  PlaneModel none = RandomModel();
+  none.classifiers.clear();
+  EXPECT_NE(message_of(none.ToYaml()).find("m.yml: no classifiers"), std::string::npos) << message_of(none.ToYaml());
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <optional>
 #include <random>
+#include <sstream>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
@@ -143,6 +144,7 @@ bool TrainOptions::Check() const {
   PDVO_CHECK_OPTION(vocabulary_samples >= std::max(gradient_words, colour_words));
   PDVO_CHECK_OPTION(kmeans_iterations >= 1);
   PDVO_CHECK_OPTION(max_regions_per_class >= 2 && max_normal_regions >= 0);
+  PDVO_CHECK_OPTION(classifiers >= 1);
   PDVO_CHECK_OPTION(layout_weight > 0);
   return true;
 }
@@ -208,28 +210,42 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   PDVO_THROW_CHECK(!non_planes.empty(), InvalidArgument,
                    "train: no non-plane regions with at least " << o.recogniser.min_points << " salient points");
   const size_t per_class = std::min({planes.size(), non_planes.size(), static_cast<size_t>(o.max_regions_per_class)});
-  for (std::vector<int>* v : {&planes, &non_planes, &normals}) std::shuffle(v->begin(), v->end(), rng);
-  planes.resize(per_class);
-  non_planes.resize(per_class);
+  PDVO_LOG(Info) << "regions with enough points: " << planes.size() << " planes (" << normals.size()
+                 << " with normals), " << non_planes.size() << " non-planes";
+  std::shuffle(normals.begin(), normals.end(), rng);
   if (normals.size() > static_cast<size_t>(o.max_normal_regions)) normals.resize(o.max_normal_regions);
-  std::vector<int> classified = planes;
-  classified.insert(classified.end(), non_planes.begin(), non_planes.end());
-  std::sort(classified.begin(), classified.end());
   std::sort(normals.begin(), normals.end());
-  std::vector<int> used;  // every region that trains something
-  std::set_union(classified.begin(), classified.end(), normals.begin(), normals.end(), std::back_inserter(used));
-  PDVO_LOG(Info) << "training regions: " << per_class << " planes, " << per_class << " non-planes, "
-                 << normals.size() << " with normals";
+  // Each classifier's draw: per_class regions of each class, sorted.
+  std::vector<std::vector<int>> draws;
+  for (int c = 0; c < o.classifiers; ++c) {
+    std::vector<int> draw;
+    for (std::vector<int>* pool : {&planes, &non_planes}) {
+      std::shuffle(pool->begin(), pool->end(), rng);
+      draw.insert(draw.end(), pool->begin(), pool->begin() + static_cast<std::ptrdiff_t>(per_class));
+    }
+    std::sort(draw.begin(), draw.end());
+    draws.push_back(std::move(draw));
+  }
+  // The topics and the standardisation are learned on the first draw and the normals' regions (the
+  // representation of a single classifier); the other draws only train classifiers.
+  std::vector<int> basis;
+  std::set_union(draws.front().begin(), draws.front().end(), normals.begin(), normals.end(), std::back_inserter(basis));
+  std::vector<int> used = basis;  // every region that trains something
+  for (const std::vector<int>& draw : draws) used.insert(used.end(), draw.begin(), draw.end());
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  PDVO_LOG(Info) << "training regions: " << o.classifiers << " draws of " << per_class << " planes and "
+                 << per_class << " non-planes, " << normals.size() << " with normals, " << used.size() << " in all";
 
   // 4. Topics by orthogonal NMF of the training regions' word histograms.
   stage = Clock::now();
   const int total_words = o.gradient_words + o.colour_words;
-  Eigen::MatrixXd histograms(total_words, used.size());
-  for (size_t k = 0; k < used.size(); ++k) histograms.col(k) = regions[used[k]].words.histogram;
+  Eigen::MatrixXd histograms(total_words, basis.size());
+  for (size_t k = 0; k < basis.size(); ++k) histograms.col(k) = regions[basis[k]].words.histogram;
   OnmfOptions topic_options = o.topics;
   topic_options.seed = seed;
-  PDVO_THROW_CHECK(static_cast<int>(used.size()) >= topic_options.topics, InvalidArgument,
-                   "train: " << used.size() << " training regions, fewer than the " << topic_options.topics
+  PDVO_THROW_CHECK(static_cast<int>(basis.size()) >= topic_options.topics, InvalidArgument,
+                   "train: " << basis.size() << " training regions, fewer than the " << topic_options.topics
                              << " topics");
   const OnmfResult topics = FactoriseOrthogonal(histograms, topic_options);
   PDVO_LOG(Info) << "[time] " << topic_options.topics << " topics (relative error "
@@ -241,10 +257,10 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (int k : used) raw[k] = RegionFeature(regions[k].words, topics.basis, o.recogniser.topic_iterations);
   const Eigen::Index dims = raw[used.front()].size();
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(dims), var = Eigen::VectorXd::Zero(dims);
-  for (int k : used) mean += raw[k];
-  mean /= used.size();
-  for (int k : used) var += (raw[k] - mean).cwiseAbs2();
-  Eigen::VectorXd scale = (var / used.size()).cwiseSqrt().cwiseMax(1e-6);
+  for (int k : basis) mean += raw[k];
+  mean /= basis.size();
+  for (int k : basis) var += (raw[k] - mean).cwiseAbs2();
+  Eigen::VectorXd scale = (var / basis.size()).cwiseSqrt().cwiseMax(1e-6);
   scale.tail(kLayoutDims) /= o.layout_weight;
   auto matrix_of = [&](const std::vector<int>& rows) {
     Eigen::MatrixXd x(rows.size(), dims);
@@ -259,13 +275,15 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   auto gamma_of = [&](double g) { return g / static_cast<double>(dims); };
 
   stage = Clock::now();
-  const Eigen::MatrixXd xc = matrix_of(classified);
-  std::vector<double> labels;
+  auto labels_of = [&](const std::vector<int>& rows) {
+    std::vector<double> labels;
+    for (int k : rows) labels.push_back(regions[k].labelled.planar ? 1.0 : -1.0);
+    return labels;
+  };
+  const Eigen::MatrixXd xc = matrix_of(draws.front());
+  const std::vector<double> labels = labels_of(draws.front());
   std::vector<int> image_c;
-  for (int k : classified) {
-    labels.push_back(regions[k].labelled.planar ? 1.0 : -1.0);
-    image_c.push_back(regions[k].image);
-  }
+  for (int k : draws.front()) image_c.push_back(regions[k].image);
   // Loss: the share of misclassified test rows.
   const WidthChoice classifier_width =
       ChooseWidth(rvm.gammas, folds, image_c, fold_of_image, "classifier error",
@@ -284,8 +302,13 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
       });
   const double best_gamma = classifier_width.gamma;
   PlaneModel model;
-  model.classifier = internal::TrainRvmClassifier(xc, labels, gamma_of(best_gamma), rvm.epsilon, rvm.max_iterations);
-  PDVO_LOG(Info) << "[time] classifier (gamma " << best_gamma << "/D, " << model.classifier.size()
+  std::ostringstream sizes;
+  for (const std::vector<int>& draw : draws) {
+    model.classifiers.push_back(internal::TrainRvmClassifier(matrix_of(draw), labels_of(draw), gamma_of(best_gamma),
+                                                             rvm.epsilon, rvm.max_iterations));
+    sizes << (sizes.tellp() > 0 ? "+" : "") << model.classifiers.back().size();
+  }
+  PDVO_LOG(Info) << "[time] " << draws.size() << " classifiers (gamma " << best_gamma << "/D, " << sizes.str()
                  << " relevance vectors) in " << Since(stage) << " s";
 
   stage = Clock::now();

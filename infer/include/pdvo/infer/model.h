@@ -1,7 +1,8 @@
 // The plane recogniser's model: everything inference needs, in ONE versioned file (cv::FileStorage YAML):
 // the recogniser options (version 2 added their `vanishing` section and two layout values), the two
-// vocabularies, the topic basis, the feature standardisation, the RVM classifier (plane probability) and three
-// RVM regressors (normal components), and a training card.
+// vocabularies, the topic basis, the feature standardisation, a committee of RVM classifiers (plane
+// probability; version 3, one classifier before) and three RVM regressors (normal components), and a training
+// card.
 // Writing is atomic; re-writing a read model gives the same bytes. Relevance vectors are stored in single
 // precision (most of the file's bytes; predictions move by about 1e-7 relative), everything else in double.
 #pragma once
@@ -9,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <string>
+#include <vector>
 
 #include "pdvo/infer/vanishing.h"
 #include "pdvo/vocab/features.h"
@@ -17,7 +19,7 @@
 namespace pdvo {
 
 inline constexpr const char* kModelFormat = "pdvo-plane-model";
-inline constexpr int kModelVersion = 2;
+inline constexpr int kModelVersion = 3;
 
 // A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
 struct RvmFunction {
@@ -53,11 +55,11 @@ struct RecogniserOptions {
 struct ModelCard {
   std::string data;            // the annotation folders, as given
   int images = 0;
-  int plane_regions = 0;       // used for the classifier (after balancing)
+  int plane_regions = 0;       // used for each classifier (after balancing)
   int non_plane_regions = 0;
   int normal_regions = 0;      // used for the normal regressors
   int folds = 0;               // cross-validation folds (grouped by image)
-  double cv_accuracy = 0;      // classifier, at the chosen kernel width
+  double cv_accuracy = 0;      // one classifier (the first draw), at the chosen kernel width
   double cv_normal_error = 0;  // mean angle, degrees
   int seed = 0;
 };
@@ -69,7 +71,9 @@ struct PlaneModel {
   Eigen::MatrixXd topics;         // (gradient words + colour words) x topics, non-negative
   Eigen::VectorXd feature_mean;   // standardisation of the region features
   Eigen::VectorXd feature_scale;
-  RvmFunction classifier;         // logit of the plane probability
+  // Each member's value is a logit of the plane probability; the probability is the members' mean (see
+  // Recogniser::Predict). Members are trained on different draws of the training regions (bagging).
+  std::vector<RvmFunction> classifiers;
   std::array<RvmFunction, 3> normal;  // x, y, z of the normal before normalisation
   ModelCard card;
 

@@ -97,7 +97,8 @@ class Recogniser {
   ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
   // The same from a region's (not standardised) feature vector, without the fusion with the region's edges
-  // (FuseNormal in vanishing.h), which needs the image.
+  // (FuseNormal in vanishing.h), which needs the image. The plane probability is the mean of the classifiers'
+  // logistic probabilities.
   RegionPrediction Predict(const Eigen::VectorXd& feature) const;
 
  private:

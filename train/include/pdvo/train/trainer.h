@@ -1,6 +1,6 @@
 // Training the plane recogniser (the paper's section III): regions sampled from annotations -> salient points
 // and descriptors -> two vocabularies (k-means) -> word histograms -> topics (orthogonal NMF) -> spatiograms ->
-// an RVM classifier and three RVM normal regressors (dlib, Tipping & Faul), kernel widths chosen by
+// a committee of RVM classifiers and three RVM normal regressors (dlib, Tipping & Faul), kernel widths chosen by
 // cross-validation grouped by image -> one PlaneModel.
 #pragma once
 
@@ -41,6 +41,10 @@ struct TrainOptions {
   // Training cost grows with the cube of the sample count: regions are drawn at random up to these bounds.
   int max_regions_per_class = 600;  // classes are balanced to the smaller class, at most this many each
   int max_normal_regions = 400;     // planes with normals for the regressors
+  // The plane probability is the mean of this many RVM classifiers (a committee), each trained on its own draw of
+  // balanced regions from all there are (bagging): one draw's classifier has few relevance vectors and moves
+  // with the draw. Their kernel width is chosen by cross-validation on the first draw.
+  int classifiers = 5;
   // The layout values (see LayoutFeature) count this much more than the others in the kernel's distance: a few
   // values among ~170 would otherwise hardly move it.
   double layout_weight = 6;
@@ -57,6 +61,7 @@ struct TrainOptions {
     visit("topics", self.topics);
     visit("max_regions_per_class", self.max_regions_per_class);
     visit("max_normal_regions", self.max_normal_regions);
+    visit("classifiers", self.classifiers);
     visit("layout_weight", self.layout_weight);
     visit("rvm", self.rvm);
   }
