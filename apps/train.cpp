@@ -13,8 +13,8 @@ namespace pdvo::apps {
 int RunTrain(int argc, char** argv) {
   CLI::App app("Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
                "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
-               "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. Writes one "
-               "model file (YAML) holding everything inference needs and a training card.",
+               "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. "
+               "Writes one model file (YAML) holding everything inference needs and a training card.",
                "pdvo train");
   std::vector<std::string> inputs, overrides;
   std::string out_path, config_path, verbosity = "info";

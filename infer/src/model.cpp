@@ -147,7 +147,8 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
   const cv::FileNode classifiers = fs["classifiers"];
   PDVO_THROW_CHECK(classifiers.isSeq() && classifiers.size() > 0, FormatError, where << ": no classifiers");
   for (size_t i = 0; i < classifiers.size(); ++i) {
-    m.classifiers.push_back(ReadRvm(classifiers[static_cast<int>(i)], where + ": classifier " + std::to_string(i), dims));
+    const std::string what = where + ": classifier " + std::to_string(i);
+    m.classifiers.push_back(ReadRvm(classifiers[static_cast<int>(i)], what, dims));
   }
   m.normal[0] = ReadRvm(fs["normal_x"], where + ": normal_x", dims);
   m.normal[1] = ReadRvm(fs["normal_y"], where + ": normal_y", dims);

@@ -147,8 +147,9 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
                    InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
   const Eigen::Index dims = RegionFeatureDims(static_cast<int>(model_.topics.cols()));
   PDVO_THROW_CHECK(!model_.classifiers.empty(), InvalidArgument, "recogniser: the model has no classifier");
-  const bool classifiers_fit = std::all_of(model_.classifiers.begin(), model_.classifiers.end(),
-                                           [&](const RvmFunction& f) { return f.size() == 0 || f.vectors.cols() == dims; });
+  const bool classifiers_fit =
+      std::all_of(model_.classifiers.begin(), model_.classifiers.end(),
+                  [&](const RvmFunction& f) { return f.size() == 0 || f.vectors.cols() == dims; });
   PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifiers_fit, InvalidArgument,
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
@@ -181,6 +182,14 @@ RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& re
   if (r.size() >= o.min_points) {
     p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
     p.normal = FuseNormal(p.normal, words.edges, region, o.vanishing);
+    // A seen plane faces the camera; the regressors' normal, when it is kept, may not. Then it becomes the nearest
+    // normal that does (edge-on to the ray): the most probable one if its error is symmetric about it.
+    const Eigen::Vector3d ray = RegionRay(words.edges.camera, region).normalized();
+    const double away = p.normal.dot(ray);
+    if (away > 0) {
+      const Eigen::Vector3d edge_on = p.normal - away * ray;
+      p.normal = edge_on.norm() > 1e-9 ? Eigen::Vector3d(edge_on.normalized()) : Eigen::Vector3d(-ray);
+    }
   }
   p.points = r.size();
   return p;

@@ -207,11 +207,14 @@ AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region&
   return l;
 }
 
+Eigen::Vector3d RegionRay(const Camera& camera, const Region& region) {
+  return camera.Unproject({region.box.x + 0.5 * (region.box.width - 1), region.box.y + 0.5 * (region.box.height - 1)});
+}
+
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& o) {
   if (!o.fuse_normals || !edges.up_found) return model_normal;
-  const Eigen::Vector3d ray = edges.camera.Unproject(
-      {region.box.x + 0.5 * (region.box.width - 1), region.box.y + 0.5 * (region.box.height - 1)});
+  const Eigen::Vector3d ray = RegionRay(edges.camera, region);
   // The fused plane is seen, so it faces the camera at the region's centre: a horizontal plane below the
   // horizon from above, one above it from below; a vertical plane on the side of the ray.
   if (std::abs(model_normal.dot(edges.up)) > o.horizontal_cos) {

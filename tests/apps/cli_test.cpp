@@ -320,7 +320,8 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   WriteAnnotation(dir / "planes/a.json", a);
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
                "no non-plane regions");
-  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifiers=0", "classifiers >= 1");
+  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifiers=0",
+               "invalid train options: classifiers >= 1 does not hold");
   // A missing image.
   a.image_path = "gone.png";
   fs::create_directories(dir / "missing");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 
@@ -93,6 +94,47 @@ TEST(Model, PlaneProbabilityIsTheClassifiersMeanProbability) {
   EXPECT_GT(std::abs(alone - mean), 1e-3);
   one.classifiers.clear();
   EXPECT_THROW(Recogniser{one}, InvalidArgument);
+}
+
+// A constant function: no relevance vectors, f(x) = -bias.
+RvmFunction Constant(double value, int dims) {
+  RvmFunction f;
+  f.bias = -value;
+  f.weights = Eigen::VectorXd(0);
+  f.vectors = Eigen::MatrixXd(0, dims);
+  return f;
+}
+
+TEST(Model, RecognisedNormalsFaceTheCamera) {
+  // Regressors that say n = (0.6, 0, 0.8) everywhere: a plane facing away from a camera looking along +z.
+  PlaneModel m = RandomModel();
+  const int dims = static_cast<int>(m.feature_mean.size());
+  m.normal = {Constant(0.6, dims), Constant(0, dims), Constant(0.8, dims)};
+  cv::Mat image(240, 320, CV_8UC3);
+  cv::theRNG().state = 5;
+  cv::randu(image, 0, 255);  // noise: many salient points, no straight edges, no vertical
+  const Region left{cv::Rect(20, 60, 100, 100), {}}, right{cv::Rect(220, 60, 90, 100), {}};
+  for (bool fuse : {false, true}) {
+    m.options.vanishing.fuse_normals = fuse;
+    const Recogniser recogniser(m);
+    const ImageWords words = recogniser.Describe(image);
+    ASSERT_FALSE(words.edges.up_found);
+    EXPECT_EQ(recogniser.Predict(Eigen::VectorXd::Zero(dims)).normal, Eigen::Vector3d(0.6, 0, 0.8));
+    for (const Region& region : {left, right}) {
+      const RegionPrediction p = recogniser.Recognise(words, region);
+      ASSERT_TRUE(p.valid);
+      // The nearest normal that faces the camera: edge-on to the ray, in the plane of the ray and the model's
+      // normal, on the model's side.
+      const Eigen::Vector3d ray = RegionRay(words.edges.camera, region).normalized();
+      const Eigen::Vector3d model(0.6, 0, 0.8);
+      ASSERT_GT(model.dot(ray), 0.1);
+      EXPECT_NEAR(p.normal.norm(), 1, 1e-12);
+      EXPECT_NEAR(p.normal.dot(ray), 0, 1e-12);
+      EXPECT_NEAR(p.normal.dot(ray.cross(model)), 0, 1e-12);
+      const auto angle = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::acos(a.dot(b)); };
+      EXPECT_NEAR(angle(p.normal, model), M_PI / 2 - angle(ray, model), 1e-9);
+    }
+  }
 }
 
 TEST(Model, RvmFunctionIsTheKernelExpansion) {

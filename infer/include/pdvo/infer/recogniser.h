@@ -84,7 +84,8 @@ struct RegionPrediction {
   bool valid = false;        // false: too few salient points to say
   int points = 0;
   double plane_probability = 0;
-  Eigen::Vector3d normal = Eigen::Vector3d(0, 0, -1);  // unit, camera frame, towards the camera
+  // Unit, camera frame, towards the camera: n . ray <= 0 for the ray through the region's centre (Recognise).
+  Eigen::Vector3d normal = Eigen::Vector3d(0, 0, -1);
 };
 
 class Recogniser {
@@ -97,8 +98,8 @@ class Recogniser {
   ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
   // The same from a region's (not standardised) feature vector, without the fusion with the region's edges
-  // (FuseNormal in vanishing.h), which needs the image. The plane probability is the mean of the classifiers'
-  // logistic probabilities.
+  // (FuseNormal in vanishing.h) and without turning the normal to face the camera, which need the image. The
+  // plane probability is the mean of the classifiers' logistic probabilities.
   RegionPrediction Predict(const Eigen::VectorXd& feature) const;
 
  private:

@@ -101,8 +101,12 @@ AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region&
 // image's y axis stands in for it). Zero for a region without pixels or edges.
 Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, const VanishingOptions& options);
 
+// The ray through the centre of `region` (camera frame, z = 1).
+Eigen::Vector3d RegionRay(const Camera& camera, const Region& region);
+
 // The fused normal (see the top of this file); `model_normal` unit, camera frame. The fused normal faces the
-// camera at the region's centre (the ray through it, from the edges' camera), as a visible plane does.
+// camera at the region's centre (RegionRay with the edges' camera), as a visible plane does. Without the
+// fusion (fuse_normals false, no vertical found, too few edges) `model_normal` is returned unchanged.
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& options);
 
