@@ -29,8 +29,9 @@ constexpr Command kCommands[] = {
 };
 
 void PrintUsage(std::ostream& out) {
-  out << "pdvo " << PDVO_VERSION << " (" << PDVO_GIT_HASH << "): planes recognised in single images as priors "
-      << "for monocular visual odometry\n\nUsage: pdvo <command> [options]   (pdvo <command> --help for more)\n\n"
+  out << "pdvo " << pdvo::apps::kVersion << " (" << pdvo::apps::kGitHash
+      << "): planes recognised in single images as priors for monocular visual odometry\n\n"
+      << "Usage: pdvo <command> [options]   (pdvo <command> --help for more)\n\n"
       << "Commands:\n";
   for (const Command& c : kCommands) {
     out << "  " << c.name << std::string(16 - std::strlen(c.name), ' ') << c.summary << "\n";
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (name == "--version") {
-    std::cout << "pdvo " << PDVO_VERSION << " (" << PDVO_GIT_HASH << ")\n";
+    std::cout << "pdvo " << pdvo::apps::kVersion << " (" << pdvo::apps::kGitHash << ")\n";
     return 0;
   }
   for (const Command& c : kCommands) {

@@ -55,6 +55,10 @@ Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path
 std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inputs);
 
 // Subcommands: each parses its own flags, returns 0 on success and throws pdvo::Error on failure.
+// The project's version and the git commit it was built from (apps/version.cpp.in).
+extern const char* const kVersion;
+extern const char* const kGitHash;
+
 int RunShow(int argc, char** argv);
 int RunValidate(int argc, char** argv);
 int RunAnnotateDepth(int argc, char** argv);
