@@ -135,6 +135,19 @@ Camera Camera::Rescaled(int new_width, int new_height) const {
   return c;
 }
 
+Camera Camera::WithFieldOfView(int width, int height, double horizontal_fov_deg) {
+  PDVO_THROW_CHECK(width > 0 && height > 0 && horizontal_fov_deg > 0 && horizontal_fov_deg < 180, InvalidArgument,
+                   "camera: a " << width << "x" << height << " image with a field of view of " << horizontal_fov_deg
+                                << " degrees");
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = 0.5 * width / std::tan(0.5 * horizontal_fov_deg * (M_PI / 180));
+  c.cx = (width - 1) / 2.0;
+  c.cy = (height - 1) / 2.0;
+  return c;
+}
+
 Undistorter::Undistorter(const Camera& camera) : camera_(camera) {
   const cv::Mat dist(1, 5, CV_64F, const_cast<double*>(camera.distortion.data()));
   cv::initUndistortRectifyMap(camera.K(), dist, cv::noArray(), camera.K(),

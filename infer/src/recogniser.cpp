@@ -177,19 +177,11 @@ RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
 RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& region) const {
   const RecogniserOptions& o = model_.options;
   RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());
-  r.edge_structure = EdgeStructure(words.edges, region, o.vanishing);
   RegionPrediction p;
   if (r.size() >= o.min_points) {
+    r.edge_structure = EdgeStructure(words.edges, region, o.vanishing);
     p = Predict(RegionFeature(r, model_.topics, o.topic_iterations));
     p.normal = FuseNormal(p.normal, words.edges, region, o.vanishing);
-    // A seen plane faces the camera; the regressors' normal, when it is kept, may not. Then it becomes the nearest
-    // normal that does (edge-on to the ray): the most probable one if its error is symmetric about it.
-    const Eigen::Vector3d ray = RegionRay(words.edges.camera, region).normalized();
-    const double away = p.normal.dot(ray);
-    if (away > 0) {
-      const Eigen::Vector3d edge_on = p.normal - away * ray;
-      p.normal = edge_on.norm() > 1e-9 ? Eigen::Vector3d(edge_on.normalized()) : Eigen::Vector3d(-ray);
-    }
   }
   p.points = r.size();
   return p;

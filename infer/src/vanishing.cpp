@@ -36,20 +36,10 @@ bool VanishingOptions::Check() const {
   return true;
 }
 
-Camera NominalCamera(cv::Size size, double field_of_view_deg) {
-  Camera c;
-  c.width = size.width;
-  c.height = size.height;
-  c.fx = c.fy = 0.5 * size.width / std::tan(0.5 * field_of_view_deg * kDegree);
-  c.cx = (size.width - 1) / 2.0;
-  c.cy = (size.height - 1) / 2.0;
-  return c;
-}
-
 EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& camera, const VanishingOptions& o) {
   PDVO_THROW_CHECK(!image.empty() && image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3),
                    InvalidArgument, "edge planes: expected an 8-bit grey or BGR image");
-  const Camera k = camera.value_or(NominalCamera(image.size(), o.field_of_view_deg));
+  const Camera k = camera.value_or(Camera::WithFieldOfView(image.cols, image.rows, o.field_of_view_deg));
   k.Check("edge planes");
   PDVO_THROW_CHECK(!k.HasDistortion() && k.width == image.cols && k.height == image.rows, InvalidArgument,
                    "edge planes: the camera (" << k.width << "x" << k.height << (k.HasDistortion() ? ", distorted" : "")
@@ -211,17 +201,31 @@ Eigen::Vector3d RegionRay(const Camera& camera, const Region& region) {
   return camera.Unproject({region.box.x + 0.5 * (region.box.width - 1), region.box.y + 0.5 * (region.box.height - 1)});
 }
 
+namespace {
+
+// `n` if it faces the camera along `ray`, else the nearest unit normal that does (edge-on to the ray): the most
+// probable one if n's error is symmetric about it.
+Eigen::Vector3d NearestFacing(const Eigen::Vector3d& n, const Eigen::Vector3d& ray) {
+  const Eigen::Vector3d r = ray.normalized();
+  const double away = n.dot(r);
+  if (away <= 0) return n;
+  const Eigen::Vector3d edge_on = n - away * r;
+  return edge_on.norm() > 1e-9 ? Eigen::Vector3d(edge_on.normalized()) : Eigen::Vector3d(-r);
+}
+
+}  // namespace
+
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& o) {
-  if (!o.fuse_normals || !edges.up_found) return model_normal;
   const Eigen::Vector3d ray = RegionRay(edges.camera, region);
+  if (!o.fuse_normals || !edges.up_found) return NearestFacing(model_normal, ray);
   // The fused plane is seen, so it faces the camera at the region's centre: a horizontal plane below the
   // horizon from above, one above it from below; a vertical plane on the side of the ray.
   if (std::abs(model_normal.dot(edges.up)) > o.horizontal_cos) {
     return edges.up.dot(ray) < 0 ? edges.up : Eigen::Vector3d(-edges.up);
   }
   const AzimuthLikelihood l = RegionAzimuthLikelihood(edges, region, o);
-  if (l.empty()) return model_normal;
+  if (l.empty()) return NearestFacing(model_normal, ray);
   const double prior_phi = l.Phi(model_normal);
   auto posterior = [&](double phi) {
     return o.prior_weight * std::cos(2 * (phi - prior_phi)) + l.MeanLogLikelihood(phi);

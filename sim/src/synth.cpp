@@ -20,14 +20,11 @@ bool SynthOptions::Check() const {
 }
 
 Camera SynthOptions::MakeCamera() const {
-  Camera c;
-  c.width = width;
-  c.height = height;
-  const double f = width / (2 * std::tan(30 * M_PI / 180));  // 60 degrees across
-  c.fx = fx > 0 ? fx : f;
-  c.fy = fy > 0 ? fy : c.fx;
-  c.cx = cx >= 0 ? cx : (width - 1) / 2.0;
-  c.cy = cy >= 0 ? cy : (height - 1) / 2.0;
+  Camera c = Camera::WithFieldOfView(width, height, 60);
+  if (fx > 0) c.fx = c.fy = fx;
+  if (fy > 0) c.fy = fy;
+  if (cx >= 0) c.cx = cx;
+  if (cy >= 0) c.cy = cy;
   return c;
 }
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -86,6 +87,19 @@ TEST(Camera, RescaleKeepsPixelCentresAndRays) {
   const Eigen::Vector2d full = c.Project(point), small = half.Project(point);
   EXPECT_NEAR(small.x(), (full.x() + 0.5) / 2 - 0.5, 1e-12);
   EXPECT_NEAR(small.y(), (full.y() + 0.5) / 2 - 0.5, 1e-12);
+}
+
+TEST(Camera, WithFieldOfViewSeesItsFieldOfView) {
+  const Camera c = Camera::WithFieldOfView(320, 240, 90);
+  EXPECT_FALSE(c.HasDistortion());
+  EXPECT_DOUBLE_EQ(c.fx, c.fy);
+  // The outer edges of the outermost pixels lie 45 degrees either side of the axis; the centre is on it.
+  EXPECT_NEAR(c.Unproject({-0.5, 119.5}).x(), -1, 1e-12);
+  EXPECT_NEAR(c.Unproject({319.5, 119.5}).x(), 1, 1e-12);
+  EXPECT_NEAR(c.Unproject({159.5, 119.5}).norm(), 1, 1e-12);
+  EXPECT_NEAR(Camera::WithFieldOfView(320, 240, 60).fx, 160 / std::tan(M_PI / 6), 1e-9);
+  EXPECT_THROW(Camera::WithFieldOfView(320, 240, 180), InvalidArgument);
+  EXPECT_THROW(Camera::WithFieldOfView(0, 240, 60), InvalidArgument);
 }
 
 TEST(Camera, UndistortedImageAgreesWithUndistortedPoints) {

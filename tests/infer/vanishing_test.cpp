@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kDegree = M_PI / 180;
 const Camera kCamera = [] {
-  Camera c = NominalCamera(cv::Size(320, 240), 60);
+  Camera c = Camera::WithFieldOfView(320, 240, 60);
   c.fx = c.fy = 277.0;
   return c;
 }();
@@ -132,7 +132,7 @@ TEST(Vanishing, WithoutTheCameraANominalFieldOfViewIsUsed) {
   EXPECT_GT(cv::norm(with.normals, wide.normals, cv::NORM_INF), 0.05);
   EXPECT_GT(AngleDeg(with.up, wide.up), 0.5);
   EXPECT_NEAR(cv::norm(FindEdgePlanes(s.image, kCamera, o).normals, with.normals, cv::NORM_INF), 0, 1e-12);
-  const Camera k = NominalCamera(cv::Size(320, 240), 90);
+  const Camera k = Camera::WithFieldOfView(320, 240, 90);
   EXPECT_NEAR(k.fx, 160, 1e-9);
   EXPECT_EQ(k.fy, k.fx);
   EXPECT_DOUBLE_EQ(k.cx, 159.5);
@@ -185,8 +185,7 @@ TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
     const double p = o.prior_weight * std::cos(2 * (phi - prior_phi)) + l.MeanLogLikelihood(phi);
     if (p > best) best = p, best_phi = phi;
   }
-  const Eigen::Vector3d ray = kCamera.Unproject(
-      {s.region.box.x + 0.5 * (s.region.box.width - 1), s.region.box.y + 0.5 * (s.region.box.height - 1)});
+  const Eigen::Vector3d ray = RegionRay(kCamera, s.region);
   EXPECT_LT(AngleDeg(fused, l.Normal(best_phi, -ray)), 0.6);
   EXPECT_LT(fused.dot(ray), 0);
   // The prior pulls towards the model, the edges to the plane: much nearer the plane.
@@ -200,10 +199,16 @@ TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
   EXPECT_NEAR(kept.dot(e.up), 0, 1e-9);  // still snapped to a vertical plane
   // The fused plane faces the camera whichever way the model's normal points.
   EXPECT_LT(AngleDeg(FuseNormal(-model, e, s.region, o), fused), 1e-9);
-  // Disabled: the model's normal as it is.
+  // Disabled: the model's normal as it is, if it faces the camera; else the nearest normal that does, edge-on
+  // to the ray and on the model's side of it.
   VanishingOptions off;
   off.fuse_normals = false;
+  ASSERT_LT(model.dot(ray), 0);
   EXPECT_EQ(FuseNormal(model, e, s.region, off), model);
+  const Eigen::Vector3d away = -model, edge_on = FuseNormal(away, e, s.region, off);
+  EXPECT_NEAR(edge_on.norm(), 1, 1e-12);
+  EXPECT_NEAR(edge_on.dot(ray), 0, 1e-12);
+  EXPECT_NEAR(AngleDeg(edge_on, away), 90 - AngleDeg(ray, away), 1e-9);
 }
 
 TEST(Vanishing, HorizontalPlanesSnapToTheVertical) {
@@ -269,13 +274,13 @@ TEST(Vanishing, BadInputsThrow) {
   EXPECT_THROW(FindEdgePlanes(cv::Mat(), kCamera, VanishingOptions()), InvalidArgument);
   EXPECT_THROW(FindEdgePlanes(cv::Mat(10, 10, CV_32F, cv::Scalar(0)), kCamera, VanishingOptions()), InvalidArgument);
   const cv::Mat small(10, 10, CV_8U, cv::Scalar(0));
-  Camera bad = NominalCamera(small.size(), 60);
+  Camera bad = Camera::WithFieldOfView(small.cols, small.rows, 60);
   bad.fx = 0;
   EXPECT_THROW(FindEdgePlanes(small, bad, VanishingOptions()), InvalidArgument);
   bad.fx = bad.fy, bad.cx = NAN;
   EXPECT_THROW(FindEdgePlanes(small, bad, VanishingOptions()), InvalidArgument);
   EXPECT_THROW(FindEdgePlanes(small, kCamera, VanishingOptions()), InvalidArgument);  // 320x240, not 10x10
-  Camera distorted = NominalCamera(small.size(), 60);
+  Camera distorted = Camera::WithFieldOfView(small.cols, small.rows, 60);
   distorted.distortion[0] = 0.1;
   EXPECT_THROW(FindEdgePlanes(small, distorted, VanishingOptions()), InvalidArgument);
   VanishingOptions o;

@@ -46,6 +46,9 @@ struct Camera {
   Camera Undistorted() const;
   // The camera of the image resized to width x height (pixel centres map to pixel centres).
   Camera Rescaled(int new_width, int new_height) const;
+  // A pinhole camera without distortion with the given horizontal field of view, square pixels and the
+  // principal point at the image's centre.
+  static Camera WithFieldOfView(int width, int height, double horizontal_fov_deg);
 
   bool operator==(const Camera&) const = default;
 };

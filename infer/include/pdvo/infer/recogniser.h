@@ -94,7 +94,7 @@ class Recogniser {
   const PlaneModel& model() const { return model_; }
 
   // Points, words and edges of an image already at the working size (see ToWorkingSize). Without `camera`,
-  // NominalCamera with the options' field of view (vanishing.h).
+  // Camera::WithFieldOfView with the options' field of view (see VanishingOptions).
   ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
   // The same from a region's (not standardised) feature vector, without the fusion with the region's edges

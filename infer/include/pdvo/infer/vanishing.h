@@ -60,10 +60,6 @@ struct VanishingOptions {
   bool operator==(const VanishingOptions&) const = default;
 };
 
-// A pinhole camera of an image of `size` with the given horizontal field of view, square pixels and the principal
-// point at the image's centre: the camera assumed when an image comes without one.
-Camera NominalCamera(cv::Size size, double field_of_view_deg);
-
 // An image's coherent edges as the unit normals of their lines' planes through the camera centre.
 struct EdgePlanes {
   Camera camera;                             // the camera the planes were found with
@@ -73,7 +69,7 @@ struct EdgePlanes {
   bool up_found = false;                     // false: too few vertical edges, or a tilt above max_tilt_deg
 };
 // `image`: 8-bit grey or BGR. `camera`: the image's, without distortion (an undistorted image's); without one,
-// NominalCamera with the options' field of view. Throws InvalidArgument for another image type, or a camera that
+// Camera::WithFieldOfView with the options' field of view. Throws InvalidArgument for another image type, or a camera that
 // fails Camera::Check, has distortion or another image size.
 EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& camera, const VanishingOptions& options);
 
@@ -104,9 +100,10 @@ Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, con
 // The ray through the centre of `region` (camera frame, z = 1).
 Eigen::Vector3d RegionRay(const Camera& camera, const Region& region);
 
-// The fused normal (see the top of this file); `model_normal` unit, camera frame. The fused normal faces the
-// camera at the region's centre (RegionRay with the edges' camera), as a visible plane does. Without the
-// fusion (fuse_normals false, no vertical found, too few edges) `model_normal` is returned unchanged.
+// The fused normal (see the top of this file); `model_normal` unit, camera frame. Without the fusion
+// (fuse_normals false, no vertical found, too few edges), `model_normal`. Either way the result faces the camera
+// at the region's centre (RegionRay with the edges' camera), as a seen plane does: a kept normal that faces away
+// becomes the nearest one that faces the camera (edge-on to the ray).
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& options);
 
