@@ -69,8 +69,8 @@ struct EdgePlanes {
   bool up_found = false;                     // false: too few vertical edges, or a tilt above max_tilt_deg
 };
 // `image`: 8-bit grey or BGR. `camera`: the image's, without distortion (an undistorted image's); without one,
-// Camera::WithFieldOfView with the options' field of view. Throws InvalidArgument for another image type, or a camera that
-// fails Camera::Check, has distortion or another image size.
+// Camera::WithFieldOfView with the options' field of view. Throws InvalidArgument for another image type, or a
+// camera that fails Camera::Check, has distortion or another image size.
 EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& camera, const VanishingOptions& options);
 
 // A region's edges as constraints on the direction phi of horizontal lines, d(phi) = cos(phi) e1 + sin(phi) e2
