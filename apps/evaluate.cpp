@@ -11,9 +11,10 @@ namespace pdvo::apps {
 
 int RunEvaluate(int argc, char** argv) {
   CLI::App app("Measures a model on annotated images: regions are sampled from the annotations as in training "
-               "(each polygon and pure square sub-windows, seeded), recognised, and compared with their labels "
-               "and normals. Reports accuracy, balanced accuracy, precision / recall of 'plane', ROC AUC, the "
-               "confusion matrix and normal errors, overall and per image.",
+               "(each polygon and sub-windows pure in its label, squares unless max_window_aspect > 1, seeded), "
+               "recognised, and compared with their labels and normals. Reports accuracy, balanced accuracy, "
+               "precision / recall of 'plane', ROC AUC, the confusion matrix and normal errors, overall and per "
+               "image.",
                "pdvo evaluate");
   std::vector<std::string> inputs, overrides;
   std::string model_path, json_path, config_path, verbosity = "info";

@@ -14,6 +14,7 @@ bool RegionSamplingOptions::Check() const {
   PDVO_CHECK_OPTION(windows_per_shape >= 0);
   PDVO_CHECK_OPTION(min_window >= 8);
   PDVO_CHECK_OPTION(max_window_fraction > 0 && max_window_fraction <= 1);
+  PDVO_CHECK_OPTION(max_window_aspect >= 1 && max_window_aspect <= 100);
   PDVO_CHECK_OPTION(min_shape_area >= 0);
   PDVO_CHECK_OPTION(whole_shapes || windows_per_shape > 0);
   return true;
@@ -51,21 +52,29 @@ std::vector<LabelledRegion> SampleRegions(const Annotation& a, cv::Size size, co
       r.whole_shape = true;
       out.push_back(std::move(r));
     }
-    const int largest = std::min({largest_side, box.width, box.height});
+    // The largest size that fits the box at some allowed aspect ratio.
+    const double fitting = std::min({std::sqrt(o.max_window_aspect) * std::min(box.width, box.height),
+                                     std::sqrt(static_cast<double>(box.area()))});
+    const int largest = static_cast<int>(std::min<double>(largest_side, fitting));
     if (o.windows_per_shape == 0 || largest < o.min_window) continue;
     cv::Mat inside;  // integral image of the shape's pixels: a window is pure if it counts its own area
     cv::integral(mask / 255, inside, CV_32S);
     std::uniform_real_distribution<double> log_side(std::log(o.min_window), std::log(largest + 1.0));
+    std::uniform_real_distribution<double> log_aspect(-std::log(o.max_window_aspect), std::log(o.max_window_aspect));
     int found = 0;
     for (int attempt = 0; attempt < 20 * o.windows_per_shape && found < o.windows_per_shape; ++attempt) {
-      const int side = std::min(largest, static_cast<int>(std::exp(log_side(rng))));
-      const int x = box.x + std::uniform_int_distribution<int>(0, box.width - side)(rng);
-      const int y = box.y + std::uniform_int_distribution<int>(0, box.height - side)(rng);
-      const int count = inside.at<int>(y + side, x + side) - inside.at<int>(y, x + side) -
-                        inside.at<int>(y + side, x) + inside.at<int>(y, x);
-      if (count != side * side) continue;
+      const double side = std::min<double>(largest, std::exp(log_side(rng)));
+      // Squares draw no aspect ratio, so that they are the same windows as before there were rectangles.
+      const double stretch = o.max_window_aspect > 1 ? std::exp(0.5 * log_aspect(rng)) : 1.0;
+      const int width = static_cast<int>(side * stretch), height = static_cast<int>(side / stretch);
+      if (width > box.width || height > box.height) continue;
+      const int x = box.x + std::uniform_int_distribution<int>(0, box.width - width)(rng);
+      const int y = box.y + std::uniform_int_distribution<int>(0, box.height - height)(rng);
+      const int count = inside.at<int>(y + height, x + width) - inside.at<int>(y, x + width) -
+                        inside.at<int>(y + height, x) + inside.at<int>(y, x);
+      if (count != width * height) continue;
       LabelledRegion r = base;
-      r.region = Region{cv::Rect(x, y, side, side), cv::Mat()};
+      r.region = Region{cv::Rect(x, y, width, height), cv::Mat()};
       out.push_back(std::move(r));
       ++found;
     }

@@ -23,6 +23,7 @@ bool WalkOptions::Check() const {
   PDVO_CHECK_OPTION(speed > 0 && fps > 0);
   PDVO_CHECK_OPTION(eye_height > 0.3 && eye_height < 3);
   PDVO_CHECK_OPTION(step_frequency >= 0 && bob >= 0 && sway >= 0 && shake_deg >= 0);
+  PDVO_CHECK_OPTION(look_deg >= 0 && look_deg <= 180);
   PDVO_CHECK_OPTION(std::abs(lateral_offset) < 3);
   return true;
 }
@@ -339,6 +340,8 @@ Trajectory WalkStreet(const Street& street, const WalkOptions& o, int frames, ui
   PDVO_THROW_CHECK(frames > 0, InvalidArgument, "walk: the number of frames must be positive, got " << frames);
   std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
   const Jitter yaw_jitter(rng), pitch_jitter(rng), roll_jitter(rng);
+  const double look_frequency = std::uniform_real_distribution<double>(1 / 30.0, 1 / 12.0)(rng);
+  const double look_phase = std::uniform_real_distribution<double>(0, 2 * M_PI)(rng);
   const double start = street.loop ? 0.0 : 8.0;  // metres into the street
   Trajectory trajectory;
   for (int i = 0; i < frames; ++i) {
@@ -351,7 +354,8 @@ Trajectory WalkStreet(const Street& street, const WalkOptions& o, int frames, ui
     Eigen::Vector3d position = SmoothPointAt(street, s) + (o.lateral_offset + o.sway * std::sin(phase)) * right;
     position.y() = -o.eye_height + o.bob * std::cos(2 * phase);
     const double deg = M_PI / 180;
-    const double yaw = std::atan2(d.x(), d.z()) + o.shake_deg * deg * yaw_jitter(t);
+    const double look = o.look_deg * deg * std::sin(2 * M_PI * look_frequency * t + look_phase);
+    const double yaw = std::atan2(d.x(), d.z()) + look + o.shake_deg * deg * yaw_jitter(t);
     const double pitch_down = 3.0 * deg + o.shake_deg * deg * pitch_jitter(t);
     const double roll = o.shake_deg * deg * roll_jitter(t) + 0.5 * deg * std::sin(phase);
     const Eigen::Quaterniond q = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY())) *

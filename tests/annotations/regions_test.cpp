@@ -19,15 +19,20 @@ Annotation Scene() {
 
 TEST(Regions, WholeShapesAndPureWindowsAtTheWorkingSize) {
   const Annotation a = Scene();
-  for (const cv::Size size : {cv::Size(400, 200), cv::Size(200, 100)}) {
+  const std::vector<std::pair<double, cv::Size>> cases = {
+      {1.0, {400, 200}}, {1.0, {200, 100}}, {4.0, {400, 200}}, {4.0, {200, 100}}};
+  for (const auto& [aspect, size] : cases) {
+    SCOPED_TRACE(aspect);
     const double s = size.width / 400.0;
     RegionSamplingOptions o;
     o.min_window = 10;
     o.min_shape_area = 0;
+    o.windows_per_shape = 40;
+    o.max_window_aspect = aspect;
     std::mt19937_64 rng(3);
     const std::vector<LabelledRegion> regions = SampleRegions(a, size, o, rng);
     const AnnotationMasks masks = Rasterise(a, size);
-    int whole = 0, windows = 0;
+    int whole = 0, windows = 0, wide = 0, tall = 0;
     for (const LabelledRegion& r : regions) {
       ASSERT_GE(r.shape, 0);
       ASSERT_LT(r.shape, 2) << "the unknown label is skipped";
@@ -41,8 +46,16 @@ TEST(Regions, WholeShapesAndPureWindowsAtTheWorkingSize) {
       }
       ++windows;
       EXPECT_TRUE(r.region.mask.empty());
-      EXPECT_EQ(r.region.box.width, r.region.box.height);
-      EXPECT_GE(r.region.box.width, o.min_window);
+      const cv::Rect& box = r.region.box;
+      if (aspect == 1) {
+        EXPECT_EQ(box.width, box.height);
+      }
+      // Sides are truncated to whole pixels: the aspect ratio and the size are within a pixel of their bounds.
+      EXPECT_LE(box.width, aspect * (box.height + 1));
+      EXPECT_LE(box.height, aspect * (box.width + 1));
+      EXPECT_GE((box.width + 1) * (box.height + 1), o.min_window * o.min_window);
+      wide += box.width > 1.5 * box.height;
+      tall += box.height > 1.5 * box.width;
       // Pure: every pixel of the window carries the shape's label.
       const cv::Mat labels = masks.label(r.region.box);
       const uchar want = r.planar ? kMaskPlane : kMaskNonPlane;
@@ -50,6 +63,10 @@ TEST(Regions, WholeShapesAndPureWindowsAtTheWorkingSize) {
     }
     EXPECT_EQ(whole, 2);
     EXPECT_EQ(windows, 2 * o.windows_per_shape);
+    if (aspect > 1) {  // of 80 windows, log-uniform aspect ratios in [1/4, 4]: about 28 wider than 1.5, 28 taller
+      EXPECT_GE(wide, 10);
+      EXPECT_GE(tall, 10);
+    }
   }
 }
 

@@ -206,10 +206,33 @@ TEST(Synth, DepthFilesReprojectWithinAMillimetre) {
   EXPECT_LT(worst, 1e-3);
 }
 
+// Looking around turns the gaze about the vertical and nothing else: the same walk, its yaw offset by up to
+// look_deg, through the whole range within a minute (a period of at most 30 s).
+TEST(Synth, LookingAroundTurnsOnlyTheGaze) {
+  const Scene s(5, 1800);
+  WalkOptions looking = s.options.walk;
+  looking.look_deg = 60;
+  const Trajectory walk = WalkStreet(s.street, looking, 1800, 5);
+  ASSERT_EQ(walk.size(), s.walk.size());
+  double largest = 0;
+  for (size_t i = 0; i < walk.size(); ++i) {
+    EXPECT_EQ(walk[i].world_from_cam.translation, s.walk[i].world_from_cam.translation);
+    const Eigen::AngleAxisd turn(walk[i].world_from_cam.rotation * s.walk[i].world_from_cam.rotation.conjugate());
+    if (turn.angle() < 1e-9) continue;
+    EXPECT_NEAR(std::abs(turn.axis().y()), 1.0, 1e-9) << "frame " << i;
+    largest = std::max(largest, turn.angle());
+  }
+  EXPECT_LE(largest, 60 * M_PI / 180 + 1e-9);
+  EXPECT_GE(largest, 59 * M_PI / 180);
+}
+
 TEST(Synth, BadOptionsAreRejected) {
   test::TempDir dir;
   SynthOptions options;
   options.street.max_turn_deg = 120;
+  EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 3, options), InvalidArgument);
+  options = SynthOptions();
+  options.walk.look_deg = -1;
   EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 3, options), InvalidArgument);
   options = SynthOptions();
   EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 0, options), InvalidArgument);

@@ -1,5 +1,5 @@
 // Training and evaluation regions from annotations (the paper's section III): each annotated polygon, and
-// square sub-windows of it at several sizes that are pure in its label. Regions live at a working resolution
+// rectangular sub-windows of it at several sizes and shapes that are pure in its label. Regions live at a working resolution
 // (the annotation's image scaled); the same seed gives the same regions.
 #pragma once
 
@@ -17,8 +17,11 @@ namespace pdvo {
 struct RegionSamplingOptions {
   bool whole_shapes = true;       // each annotated polygon is a region
   int windows_per_shape = 8;      // sub-windows tried per shape (fewer if they do not fit)
-  int min_window = 40;            // px at the working resolution: the smallest sub-window side
-  double max_window_fraction = 0.8;  // the largest side, as a fraction of the image's smaller side
+  // A sub-window's size is its geometric mean side, sqrt(width x height), log-uniform between these bounds.
+  int min_window = 40;            // px at the working resolution
+  double max_window_fraction = 0.8;  // as a fraction of the image's smaller side
+  // Its aspect ratio, width / height, is log-uniform in [1 / max_window_aspect, max_window_aspect] (1: squares).
+  double max_window_aspect = 1;
   double min_shape_area = 900;    // px^2 at the working resolution: smaller shapes are skipped
 
   template <class Self, class V>
@@ -27,6 +30,7 @@ struct RegionSamplingOptions {
     visit("windows_per_shape", self.windows_per_shape);
     visit("min_window", self.min_window);
     visit("max_window_fraction", self.max_window_fraction);
+    visit("max_window_aspect", self.max_window_aspect);
     visit("min_shape_area", self.min_shape_area);
   }
   bool Check() const;

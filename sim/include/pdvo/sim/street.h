@@ -107,6 +107,9 @@ struct WalkOptions {
   double sway = 0.03;         // m, lateral sway
   double shake_deg = 0.6;     // degrees, hand-held orientation jitter
   double lateral_offset = 0.0;// m from the centreline (positive: to the walker's right)
+  // Looking around: the gaze turns from the walking direction by up to this many degrees, slowly (a sinusoid of
+  // period 12-30 s, random phase), so that some frames see the facades from the front. 0: always ahead.
+  double look_deg = 0.0;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -118,13 +121,14 @@ struct WalkOptions {
     visit("sway", self.sway);
     visit("shake_deg", self.shake_deg);
     visit("lateral_offset", self.lateral_offset);
+    visit("look_deg", self.look_deg);
   }
   bool Check() const;
   bool operator==(const WalkOptions&) const = default;
 };
 
 // The camera poses (world_from_cam) of `frames` frames walking along the street, turning with it, with step
-// bob, sway and smooth hand-held jitter. Timestamps are frame / fps. On a loop the walk goes round and round.
+// bob, sway, smooth hand-held jitter and, if asked, a look around. Timestamps are frame / fps. On a loop the walk goes round and round.
 Trajectory WalkStreet(const Street& street, const WalkOptions& options, int frames, uint64_t seed);
 
 }  // namespace pdvo::sim
