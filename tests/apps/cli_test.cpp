@@ -247,7 +247,7 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   EXPECT_EQ(ReadFile(dir / "m.yml"), ReadFile(dir / "m2.yml"));
   // The default committee of classifiers, each trained on its own draw of regions.
   const PlaneModel model = PlaneModel::Read(dir / "m.yml");
-  ASSERT_EQ(model.classifiers.size(), 5u);
+  ASSERT_EQ(model.classifiers.size(), 15u);
   for (size_t i = 1; i < model.classifiers.size(); ++i) {
     const RvmFunction &a = model.classifiers[0], &b = model.classifiers[i];
     EXPECT_FALSE(a.size() == b.size() && a.vectors == b.vectors) << "classifiers 0 and " << i << " are the same";
