@@ -1,6 +1,6 @@
 // Training and evaluation regions from annotations (the paper's section III): each annotated polygon, and
-// rectangular sub-windows of it at several sizes and shapes that are pure in its label. Regions live at a working resolution
-// (the annotation's image scaled); the same seed gives the same regions.
+// rectangular sub-windows of it at several sizes and shapes that are pure in its label. Regions live at a working
+// resolution (the annotation's image scaled); the same seed gives the same regions.
 #pragma once
 
 #include <Eigen/Core>

@@ -128,7 +128,8 @@ struct WalkOptions {
 };
 
 // The camera poses (world_from_cam) of `frames` frames walking along the street, turning with it, with step
-// bob, sway, smooth hand-held jitter and, if asked, a look around. Timestamps are frame / fps. On a loop the walk goes round and round.
+// bob, sway, smooth hand-held jitter and, if asked, a look around. Timestamps are frame / fps. On a loop the walk
+// goes round and round.
 Trajectory WalkStreet(const Street& street, const WalkOptions& options, int frames, uint64_t seed);
 
 }  // namespace pdvo::sim
