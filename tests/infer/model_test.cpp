@@ -53,6 +53,9 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   m.Write(path);
   const PlaneModel back = PlaneModel::Read(path);
   EXPECT_EQ(back.ToYaml(), ReadFile(path));  // re-writing a read model gives the same bytes
+  // Matrices are written as their raw bytes in base64, not as text numbers (which triple the file's size).
+  EXPECT_NE(ReadFile(path).find("data: !!binary"), std::string::npos);
+  EXPECT_EQ(ReadFile(path).find("data: ["), std::string::npos);
   EXPECT_EQ(back.card.data, "synthetic streets");
   EXPECT_EQ(back.card.images, 7);
   EXPECT_EQ(back.options, m.options);

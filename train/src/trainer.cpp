@@ -306,7 +306,7 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (const std::vector<int>& draw : draws) {
     model.classifiers.push_back(internal::TrainRvmClassifier(matrix_of(draw), labels_of(draw), gamma_of(best_gamma),
                                                              rvm.epsilon, rvm.max_iterations));
-    sizes << (sizes.tellp() > 0 ? "+" : "") << model.classifiers.back().size();
+    sizes << (sizes.tellp() > 0 ? "/" : "") << model.classifiers.back().size();
   }
   PDVO_LOG(Info) << "[time] " << draws.size() << " classifiers (gamma " << best_gamma << "/D, " << sizes.str()
                  << " relevance vectors) in " << Since(stage) << " s";
