@@ -10,6 +10,7 @@
 #include "pdvo/common/file_io.h"
 #include "pdvo/common/logging.h"
 #include "pdvo/common/trajectory.h"
+#include "pdvo/vo/frames.h"
 #include "pdvo/vo/odometry.h"
 #include "tool.h"
 
@@ -41,8 +42,9 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
 int RunVo(int argc, char** argv) {
   CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
                "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to "
-               "the working width. Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and totals), map.ply (points, "
-               "planes as polygons, the camera path) and vo.yaml (the options used) to the output folder.",
+               "the working width. Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and "
+               "totals), map.ply (points, planes as polygons, the camera path) and vo.yaml (the options used) to "
+               "the output folder. All options: vo/config/default.yaml.",
                "pdvo vo");
   std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", mode, verbosity = "info";
   std::vector<std::string> overrides;
@@ -59,7 +61,7 @@ int RunVo(int argc, char** argv) {
                "Also write overlay.avi: each frame with its features (points green, plane points coloured by "
                "plane; filled where the update used the match, hollow where not found, red where RANSAC "
                "rejected it) and a status line");
-  AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "min_ncc=0.85");
+  AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "search.min_ncc=0.85");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
@@ -69,11 +71,10 @@ int RunVo(int argc, char** argv) {
   const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
   std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
   const Camera camera = SequenceCamera(*sequence, sequence_path, camera_path);
-  const Undistorter undistorter(camera);
-  const int width = options.working_width > 0 ? options.working_width : camera.width;
-  const int height = static_cast<int>(std::lround(camera.height * static_cast<double>(width) / camera.width));
-  const Camera working = camera.Undistorted().Rescaled(width, height);
-  vo::Odometry odometry({working.fx, working.fy, working.cx, working.cy}, options);
+  const vo::FramePreparer preparer(camera, options.working_width);
+  const Camera& working = preparer.working_camera();
+  const int width = working.width, height = working.height;
+  vo::Odometry odometry(working, options);
   PDVO_LOG(Info) << "vo on " << sequence->Describe() << " at " << width << "x" << height;
 
   StagedOutputDir out(out_dir);
@@ -81,7 +82,7 @@ int RunVo(int argc, char** argv) {
   size_t tracked = 0;
   nlohmann::json frames = nlohmann::json::array();
   double seconds = 0;
-  int lost = 0, keyframes = 0;
+  int lost = 0, keyframes = 0, update_failures = 0;
   const size_t total = max_frames > 0 ? std::min(max_frames, sequence->size()) : sequence->size();
   Progress progress("vo", total);
   cv::VideoWriter video;
@@ -94,11 +95,8 @@ int RunVo(int argc, char** argv) {
     PDVO_THROW_CHECK(frame.image.cols == camera.width && frame.image.rows == camera.height, FormatError,
                      frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
                                       << ", the camera says " << camera.width << "x" << camera.height);
-    cv::Mat colour, small;
-    cv::resize(undistorter.Apply(frame.image), colour, cv::Size(width, height), 0, 0,
-               width < camera.width ? cv::INTER_AREA : cv::INTER_LINEAR);
-    cv::cvtColor(colour, small, cv::COLOR_BGR2GRAY);
-    const vo::FrameStats s = odometry.Track(small, frame.timestamp);
+    const vo::PreparedFrame prepared = preparer.Prepare(frame.image);
+    const vo::FrameStats s = odometry.Track(prepared.grey, frame.timestamp);
     seconds += s.seconds;
     lost += s.lost;
     keyframes += s.keyframe;
@@ -107,8 +105,9 @@ int RunVo(int argc, char** argv) {
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
                       {"plane_points", s.plane_points},
                       {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost},
-                      {"bootstrap", s.bootstrap}});
-    if (overlay) video.write(DrawOverlay(colour, odometry.observations(), s));
+                      {"bootstrap", s.bootstrap}, {"update", vo::ToString(s.update)}});
+    update_failures += s.update != vo::UpdateStatus::kOk && s.update != vo::UpdateStatus::kNoMeasurements;
+    if (overlay) video.write(DrawOverlay(prepared.colour, odometry.observations(), s));
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
                      std::to_string(s.planes) + " planes");
     progress.Step();
@@ -116,6 +115,10 @@ int RunVo(int argc, char** argv) {
   progress.Finish();
   video.release();
   PDVO_THROW_CHECK(tracked > 0, FormatError, sequence_path << ": no frames");
+  if (update_failures > 0) {
+    PDVO_LOG(Warning) << "vo: the update failed and was skipped in " << update_failures
+                      << " frames (stats.json: frames[].update)";
+  }
   const Trajectory& trajectory = odometry.trajectory();  // with the poses the bootstrap revised
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const vo::Map map = odometry.map();
@@ -127,6 +130,7 @@ int RunVo(int argc, char** argv) {
                                  {"fps", fps},
                                  {"keyframes", keyframes},
                                  {"lost", lost},
+                                 {"update_failures", update_failures},
                                  {"planes", mapping.planes},
                                  {"points_per_plane", mapping.points_per_plane},
                                  {"mean_plane_area_px", mapping.mean_plane_area},

@@ -5,12 +5,11 @@
 // resident memory of tracking (rendered frames excluded). The NEES takes the camera the filter fixed when it
 // started (the first frame, or the frame of the two-view bootstrap) as exact. In idpp mode, the purity of the
 // planes: how many of their points lie on the same true surface.
-// Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp pixel_sigma=0.5)
+// Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
-#include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
@@ -20,6 +19,7 @@
 #include "memory.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
+#include "pdvo/vo/frames.h"
 #include "pdvo/vo/odometry.h"
 
 using pdvo::bench::ResidentMiB;
@@ -49,15 +49,14 @@ int main(int argc, char** argv) {
   const pdvo::Trajectory walk = pdvo::sim::WalkStreet(street, options.walk, frames, seed);
   std::vector<cv::Mat> grey;
   const pdvo::sim::Renderer renderer(street, camera, options.render, seed);
+  const pdvo::vo::FramePreparer preparer(camera, vo_options.working_width);  // as pdvo vo prepares frames
   for (const pdvo::StampedPose& pose : walk) {
     pdvo::sim::RenderedFrame frame;
     renderer.Render({pose.world_from_cam}, pose.timestamp, grey.size(), &frame);
-    cv::Mat g;
-    cv::cvtColor(frame.image, g, cv::COLOR_BGR2GRAY);
-    grey.push_back(g);
+    grey.push_back(preparer.Prepare(frame.image).grey);
   }
   const double before = ResidentMiB();
-  pdvo::vo::Odometry odometry({camera.fx, camera.fy, camera.cx, camera.cy}, vo_options);
+  pdvo::vo::Odometry odometry(preparer.working_camera(), vo_options);
   int keyframes = 0, lost = 0, bootstrap = -1;
   double measurements = 0, peak = before, nees_sum = 0, relative_nees_sum = 0;
   // The newest keyframe's orientation, estimated and true.
@@ -131,7 +130,7 @@ int main(int argc, char** argv) {
   long plane_members = 0;
   const double pure = purity.Share(4, &plane_members);
   std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,
-              static_cast<unsigned long long>(seed), vo_options.mode.c_str(), path);
+              static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(), path);
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
   std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n",
               ate.translation.rmse, 100 * ate.translation.rmse / path, ate.translation.max);

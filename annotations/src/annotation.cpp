@@ -115,8 +115,14 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
     const json& c = j["camera"];
     const std::string cw = where + ": camera";
     PDVO_THROW_CHECK(c.is_object(), FormatError, cw << ": must be an object with fx, fy, cx, cy");
-    a.camera = AnnotationCamera{Number(Required(c, "fx", cw), cw, "fx"), Number(Required(c, "fy", cw), cw, "fy"),
-                                Number(Required(c, "cx", cw), cw, "cx"), Number(Required(c, "cy", cw), cw, "cy")};
+    Camera camera;
+    camera.width = a.image_width;
+    camera.height = a.image_height;
+    camera.fx = Number(Required(c, "fx", cw), cw, "fx");
+    camera.fy = Number(Required(c, "fy", cw), cw, "fy");
+    camera.cx = Number(Required(c, "cx", cw), cw, "cx");
+    camera.cy = Number(Required(c, "cy", cw), cw, "cy");
+    a.camera = camera;
   }
   const json& shapes = Required(j, "shapes", where);
   PDVO_THROW_CHECK(shapes.is_array(), FormatError, where << ": 'shapes' must be a list");
@@ -270,7 +276,7 @@ std::vector<ValidationIssue> Validate(const Annotation& a) {
       Eigen::Vector2d c = Eigen::Vector2d::Zero();
       for (const auto& p : distinct) c += p;
       c /= static_cast<double>(distinct.size());
-      const Eigen::Vector3d ray((c.x() - a.camera->cx) / a.camera->fx, (c.y() - a.camera->cy) / a.camera->fy, 1);
+      const Eigen::Vector3d ray = a.camera->Unproject(c);
       if (n.dot(ray) >= 0) error(index, "normal points away from the camera");
     }
   }

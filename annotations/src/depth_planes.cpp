@@ -332,7 +332,7 @@ Annotation DepthPlaneFinder::Annotate(const cv::Mat& depth, const std::string& i
   a.image_path = image_path;
   a.image_width = camera_.width;
   a.image_height = camera_.height;
-  a.camera = AnnotationCamera{camera_.fx, camera_.fy, camera_.cx, camera_.cy};
+  a.camera = camera_.Undistorted();  // the format holds pinhole intrinsics
   AddShapesFromMasks(std::vector<PlaneMask>(planes.begin(), planes.end()), nonplanar, polygons, &a);
   return a;
 }

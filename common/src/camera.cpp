@@ -91,6 +91,7 @@ bool Camera::HasDistortion() const {
 cv::Matx33d Camera::K() const { return cv::Matx33d(fx, 0, cx, 0, fy, cy, 0, 0, 1); }
 
 Eigen::Vector2d Camera::Project(const Eigen::Vector3d& p) const {
+  if (!HasDistortion()) return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   const double x = p.x() / p.z(), y = p.y() / p.z();
   const auto& [k1, k2, p1, p2, k3] = distortion;
   const double r2 = x * x + y * y;
@@ -104,6 +105,8 @@ Eigen::Vector3d Camera::Unproject(const Eigen::Vector2d& pixel) const {
   const cv::Point2d u = UndistortPoints({cv::Point2d(pixel.x(), pixel.y())})[0];
   return {(u.x - cx) / fx, (u.y - cy) / fy, 1.0};
 }
+
+Eigen::Vector3d Camera::Ray(const Eigen::Vector2d& pixel) const { return Unproject(pixel).normalized(); }
 
 std::vector<cv::Point2d> Camera::UndistortPoints(const std::vector<cv::Point2d>& pixels) const {
   if (!HasDistortion() || pixels.empty()) return pixels;
@@ -132,6 +135,18 @@ Camera Camera::Rescaled(int new_width, int new_height) const {
   c.fy = fy * sy;
   c.cx = (cx + 0.5) * sx - 0.5;
   c.cy = (cy + 0.5) * sy - 0.5;
+  return c;
+}
+
+Camera Camera::Pinhole(int width, int height, double fx, double fy, double cx, double cy) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fx = fx;
+  c.fy = fy;
+  c.cx = cx;
+  c.cy = cy;
+  c.Check("pinhole camera");
   return c;
 }
 

@@ -132,13 +132,7 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
                    image_path << ": image is " << image.cols << "x" << image.rows << ", its annotation says "
                               << a.annotation.image_width << "x" << a.annotation.image_height);
   a.image = ToWorkingSize(image, working_width);
-  if (a.annotation.camera) {
-    const AnnotationCamera& k = *a.annotation.camera;
-    Camera full;
-    full.width = image.cols, full.height = image.rows;
-    full.fx = k.fx, full.fy = k.fy, full.cx = k.cx, full.cy = k.cy;
-    a.camera = full.Rescaled(a.image.cols, a.image.rows);
-  }
+  if (a.annotation.camera) a.camera = a.annotation.camera->Rescaled(a.image.cols, a.image.rows);
   return a;
 }
 

@@ -34,7 +34,7 @@ Annotation AnnotateFrame(const Street& street, const RenderedFrame& frame, const
   a.image_path = image_path;
   a.image_width = camera.width;
   a.image_height = camera.height;
-  a.camera = AnnotationCamera{camera.fx, camera.fy, camera.cx, camera.cy};
+  a.camera = camera.Undistorted();  // the format holds pinhole intrinsics
   // Visible planes, by pixel count, largest first.
   std::vector<int> count(street.planes.size(), 0);
   cv::Mat grouped(frame.id.size(), CV_32S, cv::Scalar(-1));

@@ -14,7 +14,7 @@ Annotation Square(double x0, double y0, double size, const char* label = kPlaneL
   a.image_path = "img.png";
   a.image_width = 100;
   a.image_height = 80;
-  a.camera = AnnotationCamera{90, 90, 49.5, 39.5};
+  a.camera = Camera::Pinhole(a.image_width, a.image_height, 90, 90, 49.5, 39.5);
   AnnotationShape s;
   s.label = label;
   s.points = {{x0, y0}, {x0 + size, y0}, {x0 + size, y0 + size}, {x0, y0 + size}};

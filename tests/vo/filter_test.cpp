@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <limits>
 #include <random>
 
 #include "pdvo/common/errors.h"
@@ -13,7 +14,8 @@
 namespace pdvo::vo {
 namespace {
 
-const Pinhole kCamera{277.0, 277.0, 159.5, 119.5};
+const Camera kCamera = Camera::Pinhole(320, 240, 277.0, 277.0, 159.5, 119.5);
+const MotionNoise kNoise{2.0, 2.0};  // m/s^2, rad/s^2
 
 Matrix12d SmallCovariance() {
   Vector12d sigma;
@@ -34,11 +36,11 @@ Filter BusyFilter() {
   Filter f(c, SmallCovariance());
   const int r0 = f.AddReference(false);
   for (int k = 0; k < 3; ++k) f.AddPoint(r0, kCamera.Ray({80.0 + 60 * k, 100.0 + 10 * k}), 0.2 + 0.1 * k, 0.1);
-  for (int k = 0; k < 5; ++k) f.Predict(1.0 / 30, {});
+  for (int k = 0; k < 5; ++k) f.Predict(1.0 / 30, kNoise);
   const int r1 = f.AddReference(false);
   for (int k = 0; k < 2; ++k) f.AddPoint(r1, kCamera.Ray({120.0 + 50 * k, 90.0}), 0.3, 0.2);
   f.AddPlane(r0, {Eigen::Vector3d(0.3, -0.1, -1.0), 0.2}, 0.2, 0.05);
-  f.Predict(1.0 / 30, {});
+  f.Predict(1.0 / 30, kNoise);
   return f;
 }
 
@@ -161,7 +163,7 @@ TEST(Filter, PointJoiningAPlaneIsFusedIntoIt) {
   const double point_variance = p(point_offset, point_offset);
   ASSERT_NEAR(point_variance, std::pow(0.2 * on_plane, 2), 1e-15);
 
-  f.MergePointIntoPlane(point, plane, sigma);
+  ASSERT_EQ(f.MergePointIntoPlane(point, plane, sigma), UpdateStatus::kOk);
   EXPECT_FALSE(f.points().count(point));
   ASSERT_EQ(f.size(), n - 1);
   const double gain = plane_variance / (plane_variance + point_variance + sigma * sigma);
@@ -182,7 +184,7 @@ TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   CameraState c;
   c.position = Eigen::Vector3d(1, 2, 3);
   Filter f(c, SmallCovariance());
-  f.Predict(0.1, {});
+  f.Predict(0.1, kNoise);
   const int r = f.AddReference(false);
   const Filter::Reference& ref = f.references().at(r);
   EXPECT_EQ(ref.offset, 12);
@@ -221,7 +223,7 @@ TEST(Filter, FixedReferenceIsNotMovedByUpdates) {
       ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, nullptr));
       z.push_back({id, pixel + Eigen::Vector2d(2 + noise(rng), noise(rng)), 0.5});  // all shifted 2 px right
     }
-    f.Update(kCamera, z);
+    ASSERT_TRUE(f.Update(kCamera, z).ok());
   }
   EXPECT_EQ(f.references().at(r).world_from_cam.translation, pose.translation);
   EXPECT_EQ(f.references().at(r).world_from_cam.rotation.coeffs(), pose.rotation.coeffs());
@@ -291,7 +293,7 @@ RunResult SimulateRun(std::mt19937& rng, double pixel_sigma, double velocity_sig
       const Eigen::Vector3d in_cam = truth.world_from_cam().Inverse() * x;
       z.push_back({id, kCamera.Project(in_cam) + Eigen::Vector2d(noise(rng), noise(rng)), pixel_sigma});
     }
-    f.Update(kCamera, z);
+    EXPECT_TRUE(f.Update(kCamera, z).ok());
     const Eigen::Vector3d e = f.camera().position - truth.position;
     out.nees.push_back(e.dot(f.covariance().topLeftCorner<3, 3>().ldlt().solve(e)));
   }
@@ -360,7 +362,7 @@ TEST(Filter, PlaneConvergesToTheTruthFromFrontoParallel) {
       const Eigen::Vector2d pixel = kCamera.Project(truth.world_from_cam().Inverse() * on_plane);
       z.push_back({plane, pixel + Eigen::Vector2d(noise(rng), noise(rng)), 0.5, m});
     }
-    f.Update(kCamera, z);
+    ASSERT_TRUE(f.Update(kCamera, z).ok());
   }
   const InversePlane& estimate = f.planes().at(plane).plane;
   EXPECT_LT(std::acos(std::min(1.0, estimate.normal.normalized().dot(normal))) * 180 / M_PI, 2.0)
@@ -378,16 +380,76 @@ TEST(Filter, CovarianceStaysSymmetricPositiveSemidefinite) {
   std::mt19937 rng(13);
   std::normal_distribution<double> noise(0, 1);
   for (int frame = 0; frame < 20; ++frame) {
-    f.Predict(1.0 / 30, {});
+    f.Predict(1.0 / 30, kNoise);
     std::vector<PointMeasurement> z;
     for (const auto& [id, p] : f.points()) {
       Eigen::Vector2d pixel;
       if (f.PredictPoint(kCamera, id, &pixel, nullptr)) z.push_back({id, pixel + Eigen::Vector2d(noise(rng), noise(rng)), 1});
     }
-    f.Update(kCamera, z);
+    ASSERT_TRUE(f.Update(kCamera, z).ok());
     EXPECT_LT((f.covariance() - f.covariance().transpose()).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
   }
+}
+
+
+// Step and PredictAfter (1-point RANSAC's hypotheses) give exactly what an update of a copy would: the same step,
+// bit for bit, and the same predictions after it; the filter itself is unchanged.
+TEST(Filter, StepIsTheUpdateWithoutChangingTheFilter) {
+  Filter f = BusyFilter();
+  std::vector<PointMeasurement> all;
+  for (const auto& [id, p] : f.points()) {
+    Eigen::Vector2d pixel;
+    ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, nullptr));
+    all.push_back({id, pixel + Eigen::Vector2d(0.7, -0.4), 0.5});
+  }
+  const Eigen::MatrixXd covariance = f.covariance();
+  const CameraState camera = f.camera();
+  Eigen::VectorXd step;
+  ASSERT_EQ(f.Step(kCamera, {all[0]}, &step), UpdateStatus::kOk);
+  EXPECT_EQ(f.covariance(), covariance);
+  EXPECT_EQ(f.camera().position, camera.position);
+  Filter updated = f;
+  ASSERT_TRUE(updated.Update(kCamera, {all[0]}).ok());
+  std::vector<Eigen::Vector2d> after;
+  std::vector<bool> predicted;
+  f.PredictAfter(kCamera, all, step, &after, &predicted);
+  for (size_t k = 0; k < all.size(); ++k) {
+    Eigen::Vector2d expected;
+    ASSERT_TRUE(updated.PredictMeasurement(kCamera, all[k], &expected, nullptr));
+    ASSERT_TRUE(predicted[k]);
+    EXPECT_EQ(after[k], expected) << k;  // bit for bit
+  }
+  EXPECT_EQ(updated.camera().position, f.camera().Plus(step.head<12>()).position);
+}
+
+// Updates that cannot be made are values, and leave the filter as it was.
+TEST(Filter, FailedUpdatesAreValues) {
+  Filter f = BusyFilter();
+  EXPECT_EQ(f.Update(kCamera, {}).status, UpdateStatus::kNoMeasurements);
+  const int point = f.points().begin()->first;
+  Eigen::Vector2d pixel;
+  ASSERT_TRUE(f.PredictPoint(kCamera, point, &pixel, nullptr));
+  const Eigen::MatrixXd before = f.covariance();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(f.Update(kCamera, {{point, Eigen::Vector2d(nan, 1), 0.5}}).status, UpdateStatus::kNonFinite);
+  EXPECT_FALSE(f.Update(kCamera, {{point, pixel, nan}}).ok());
+  EXPECT_EQ(f.covariance(), before);
+  // Nothing uncertain and exact measurements: the innovation covariance is zero, not positive.
+  Filter certain(CameraState(), Matrix12d::Zero());
+  const int reference = certain.AddReference(true);
+  const int exact = certain.AddPoint(reference, Eigen::Vector3d::UnitZ(), 0.2, 1e-200);  // its variance underflows
+  Eigen::Vector2d centre;
+  ASSERT_TRUE(certain.PredictPoint(kCamera, exact, &centre, nullptr));
+  EXPECT_EQ(certain.Update(kCamera, {{exact, centre, 0.0}}).status, UpdateStatus::kNotPositive);
+  Eigen::VectorXd step;
+  EXPECT_EQ(certain.Step(kCamera, {{exact, centre, 0.0}}, &step), UpdateStatus::kNotPositive);
+  // A point behind the camera: moved behind it by a step of the camera.
+  Filter behind = f;
+  Eigen::VectorXd jump = Eigen::VectorXd::Zero(f.size());
+  jump.head<3>() = Eigen::Vector3d(0, 0, 100);
+  behind.Apply(jump);
+  EXPECT_EQ(behind.Update(kCamera, {{point, pixel, 0.5}}).status, UpdateStatus::kNotInFront);
 }
 
 }  // namespace

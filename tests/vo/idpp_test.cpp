@@ -9,7 +9,7 @@
 namespace pdvo::vo {
 namespace {
 
-const Pinhole kCamera{277.1, 280.4, 159.5, 119.5};
+const Camera kCamera = Camera::Pinhole(320, 240, 277.1, 280.4, 159.5, 119.5);
 
 Eigen::Vector3d RandomVector(std::mt19937& rng, double sigma) {
   std::normal_distribution<double> g(0, sigma);

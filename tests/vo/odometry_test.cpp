@@ -58,7 +58,7 @@ const Street& TestStreet() {
 
 Trajectory RunOdometry(const Street& s, std::vector<FrameStats>* stats, const VoOptions& options = {},
                        MappingStats* mapping = nullptr) {
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, options);
+  Odometry odometry(s.camera, options);
   for (size_t k = 0; k < s.grey.size(); ++k) stats->push_back(odometry.Track(s.grey[k], s.walk[k].timestamp));
   if (mapping) *mapping = odometry.mapping();
   return odometry.trajectory();
@@ -79,7 +79,7 @@ TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
   const double length = PathLength(s.walk);
   EXPECT_EQ(ate.matched, s.walk.size());
   // Measured 1.39% of the path on this street (2.27% with reference cameras tracked in the state); 0.97% without
-  // the two-view bootstrap (bootstrap_frames=0): the frames before it keep the two-view's scale, which the filter
+  // the two-view bootstrap (bootstrap.frames=0): the frames before it keep the two-view's scale, which the filter
   // revises in the frames after it. Over 1,000 frames the bootstrap helps (README.md). A constant velocity
   // extrapolation would be off by metres.
   EXPECT_LT(ate.translation.rmse, 0.03 * length) << "path " << length << " m";
@@ -90,7 +90,7 @@ TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
 // rotation, and the trajectory holds every frame, the last one being the filter's camera.
 TEST(Odometry, BootstrapFindsTheMotion) {
   const Street& s = TestStreet();
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  Odometry odometry(s.camera, VoOptions{});
   int at = -1;
   for (size_t k = 0; k < s.grey.size(); ++k) {
     if (odometry.Track(s.grey[k], s.walk[k].timestamp).bootstrap) {
@@ -105,7 +105,7 @@ TEST(Odometry, BootstrapFindsTheMotion) {
     }
   }
   EXPECT_GT(at, 0);
-  EXPECT_LE(at, VoOptions{}.bootstrap_frames);
+  EXPECT_LE(at, VoOptions{}.bootstrap.frames);
   const Trajectory& trajectory = odometry.trajectory();
   ASSERT_EQ(trajectory.size(), s.walk.size());
   EXPECT_TRUE(trajectory.back().world_from_cam.translation.isApprox(odometry.world_from_cam().translation));
@@ -124,7 +124,7 @@ TEST(Odometry, BootstrapFindsTheMotion) {
 // a depth edge are left out of the first check: their true position is ill-defined at the patch's centre.
 TEST(Odometry, UsedMatchesAgreeWithTheTruth) {
   const Street& s = TestStreet();
-  const Pinhole camera{s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy};
+  const Camera& camera = s.camera;
   Odometry odometry(camera, VoOptions{});
   std::vector<double> used_errors, rejected_errors, edge_used_errors;
   for (size_t k = 0; k < s.grey.size(); ++k) {
@@ -179,11 +179,11 @@ TEST(Odometry, UsedMatchesAgreeWithTheTruth) {
 // the first, most new points' priors are within a factor of 1.5 of their true inverse depth (rendered depth).
 TEST(Odometry, NewPointsStartNearTheirTrueDepth) {
   const Street& s = TestStreet();
-  const Pinhole camera{s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy};
+  const Camera& camera = s.camera;
   // Without the two-view bootstrap: it restarts the filter with priors of its own, and the map's scale settles
   // again after it, which the single scale below does not describe.
   VoOptions options;
-  options.bootstrap_frames = 0;
+  options.bootstrap.frames = 0;
   Odometry odometry(camera, options);
   int newest = -1, near = 0, total = 0;
   for (size_t k = 0; k < s.grey.size(); ++k) {
@@ -218,7 +218,7 @@ TEST(Odometry, NewPointsStartNearTheirTrueDepth) {
 TEST(Odometry, IdppModeGrowsPlanes) {
   const Street& s = TestStreet();
   VoOptions options;
-  options.mode = "idpp";
+  options.mode = PlaneMode::kIdpp;
   std::vector<FrameStats> stats;
   MappingStats mapping;
   const Trajectory estimate = RunOdometry(s, &stats, options, &mapping);
@@ -229,7 +229,7 @@ TEST(Odometry, IdppModeGrowsPlanes) {
   }
   EXPECT_GT(with_planes, 0);
   EXPECT_GE(mapping.planes, 1);
-  EXPECT_GE(mapping.points_per_plane, options.min_plane_points);
+  EXPECT_GE(mapping.points_per_plane, options.planes.min_plane_points);
   EXPECT_GT(mapping.mean_plane_area, 0);
   const AteResult ate = ComputeAte(s.walk, estimate, Alignment::kSim3, 1e-3);
   const double length = PathLength(s.walk);
@@ -241,7 +241,7 @@ TEST(Odometry, IdppModeGrowsPlanes) {
 // A plane's points lie on one true surface: in every frame, of the points of each plane in view (4 or more),
 // the share on the plane's most common surface (by the rendered ids at their keyframe pixels).
 double PurityOfPlanes(const Street& s, const VoOptions& options) {
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, options);
+  Odometry odometry(s.camera, options);
   PlanePurity purity;
   for (size_t k = 0; k < s.grey.size(); ++k) {
     odometry.Track(s.grey[k], s.walk[k].timestamp);
@@ -261,9 +261,9 @@ double PurityOfPlanes(const Street& s, const VoOptions& options) {
 TEST(Odometry, PlanePointsLieOnOneSurface) {
   const Street& s = TestStreet();
   VoOptions options;
-  options.mode = "idpp";
+  options.mode = PlaneMode::kIdpp;
   const double purity = PurityOfPlanes(s, options);
-  options.join_gate = 3;
+  options.planes.join_gate = 3;
   const double loose = PurityOfPlanes(s, options);
   // Measured on this street: 0.77 with the default gate of 2 standard deviations, 0.35 with 3.
   EXPECT_GT(purity, 0.7);
@@ -286,7 +286,7 @@ TEST(Odometry, TheSameFramesGiveTheSameTrajectory) {
 // with a finite pose.
 TEST(Odometry, SaysWhenItIsLostAndStartsAgain) {
   const Street& s = TestStreet();
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  Odometry odometry(s.camera, VoOptions{});
   const cv::Mat blank(s.grey[0].size(), CV_8U, cv::Scalar(90));
   int lost = 0, lost_at = -1;
   for (size_t k = 0; k < s.grey.size(); ++k) {
@@ -306,15 +306,18 @@ TEST(Odometry, SaysWhenItIsLostAndStartsAgain) {
 
 TEST(Odometry, RefusesBadFrames) {
   const Street& s = TestStreet();
-  Odometry odometry({s.camera.fx, s.camera.fy, s.camera.cx, s.camera.cy}, VoOptions{});
+  Odometry odometry(s.camera, VoOptions{});
   EXPECT_THROW(odometry.Track(cv::Mat(240, 320, CV_8UC3), 0), InvalidArgument);  // colour
   EXPECT_THROW(odometry.Track(cv::Mat(), 0), InvalidArgument);
   odometry.Track(s.grey[0], 1.0);
   EXPECT_THROW(odometry.Track(s.grey[1], 1.0), InvalidArgument);                   // time did not advance
   EXPECT_THROW(odometry.Track(s.grey[1](cv::Rect(0, 0, 100, 100)).clone(), 2.0), InvalidArgument);  // size
   VoOptions bad;
-  bad.border = bad.patch_half;  // patches would leave the image
-  EXPECT_THROW(Odometry({1, 1, 0, 0}, bad), InvalidArgument);
+  bad.features.border = bad.search.patch_half;  // patches would leave the image
+  EXPECT_THROW(Odometry(s.camera, bad), InvalidArgument);
+  Camera distorted = s.camera;
+  distorted.distortion[0] = 0.1;
+  EXPECT_THROW(Odometry(distorted, VoOptions{}), InvalidArgument);  // frames must be undistorted
 }
 
 }  // namespace

@@ -8,6 +8,17 @@
 
 namespace pdvo::vo {
 
+const char* ToString(UpdateStatus status) {
+  switch (status) {
+    case UpdateStatus::kOk: return "ok";
+    case UpdateStatus::kNoMeasurements: return "no-measurements";
+    case UpdateStatus::kNotInFront: return "not-in-front";
+    case UpdateStatus::kNotPositive: return "not-positive";
+    case UpdateStatus::kNonFinite: return "non-finite";
+  }
+  return "?";
+}
+
 Filter::Filter(const CameraState& camera, const Matrix12d& covariance) : camera_(camera), covariance_(covariance) {}
 
 void Filter::Predict(double dt, const MotionNoise& noise) {
@@ -131,7 +142,7 @@ int Filter::PlaneToPoint(int plane_id, const Eigen::Vector3d& ray) {
   return id;
 }
 
-void Filter::MergePointIntoPlane(int point_id, int plane_id, double sigma) {
+UpdateStatus Filter::MergePointIntoPlane(int point_id, int plane_id, double sigma) {
   PDVO_THROW_CHECK(points_.count(point_id) && planes_.count(plane_id), InvalidArgument,
                    "filter: no point " << point_id << " or plane " << plane_id);
   PDVO_THROW_CHECK(sigma > 0, InvalidArgument, "filter: a plane merge needs a positive sigma, got " << sigma);
@@ -140,12 +151,15 @@ void Filter::MergePointIntoPlane(int point_id, int plane_id, double sigma) {
   PDVO_THROW_CHECK(p.reference == q.reference, InvalidArgument,
                    "filter: point " << point_id << " and plane " << plane_id << " have different reference cameras");
   // r = rho_point - rho_plane(ray), measured as 0.
-  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(1, size());
-  h(0, p.offset) = 1;
-  h.block<1, 4>(0, q.offset) = -q.plane.InverseDepthJacobian(p.ray);
-  Correct(h, Eigen::VectorXd::Constant(1, q.plane.InverseDepthAlong(p.ray) - p.inverse_depth),
-          Eigen::VectorXd::Constant(1, sigma * sigma));
-  RemovePoint(point_id);
+  Linearised l;
+  l.h = Eigen::MatrixXd::Zero(1, size());
+  l.h(0, p.offset) = 1;
+  l.h.block<1, 4>(0, q.offset) = -q.plane.InverseDepthJacobian(p.ray);
+  l.innovation = Eigen::VectorXd::Constant(1, q.plane.InverseDepthAlong(p.ray) - p.inverse_depth);
+  l.noise = Eigen::VectorXd::Constant(1, sigma * sigma);
+  const UpdateResult fused = Correct(l);
+  if (fused.ok()) RemovePoint(point_id);
+  return fused.status;
 }
 
 void Filter::Renumber() {
@@ -167,7 +181,7 @@ void Filter::Renumber() {
   }
 }
 
-bool Filter::PredictPoint(const Pinhole& camera, int id, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
+bool Filter::PredictPoint(const Camera& camera, int id, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
   const Point& p = points_.at(id);
   const Reference& r = references_.at(p.reference);
   ProjectionJacobians j;
@@ -184,7 +198,7 @@ bool Filter::PredictPoint(const Pinhole& camera, int id, Eigen::Vector2d* pixel,
   return true;
 }
 
-bool Filter::PredictPlanePoint(const Pinhole& camera, int id, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
+bool Filter::PredictPlanePoint(const Camera& camera, int id, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                                Eigen::MatrixXd* jacobian) const {
   const Plane& p = planes_.at(id);
   const Reference& r = references_.at(p.reference);
@@ -203,42 +217,102 @@ bool Filter::PredictPlanePoint(const Pinhole& camera, int id, const Eigen::Vecto
   return true;
 }
 
-bool Filter::PredictMeasurement(const Pinhole& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
+bool Filter::PredictMeasurement(const Camera& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
                                 Eigen::MatrixXd* jacobian) const {
   return planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
                                 : PredictPoint(camera, z.point, pixel, jacobian);
 }
 
-double Filter::Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements) {
-  if (measurements.empty()) return 0;
+UpdateStatus Filter::Linearise(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                               Linearised* l) const {
+  if (measurements.empty()) return UpdateStatus::kNoMeasurements;
   const int m = 2 * static_cast<int>(measurements.size()), n = size();
-  Eigen::MatrixXd h(m, n);
-  Eigen::VectorXd innovation(m), noise(m);
+  l->h.resize(m, n);
+  l->innovation.resize(m);
+  l->noise.resize(m);
   for (size_t k = 0; k < measurements.size(); ++k) {
     Eigen::Vector2d predicted;
     Eigen::MatrixXd jk;
     const PointMeasurement& z = measurements[k];
-    const bool in_front = PredictMeasurement(camera, z, &predicted, &jk);
-    PDVO_THROW_CHECK(in_front, InvalidArgument, "filter: feature " << z.point << " is not in front of the camera");
-    h.middleRows<2>(2 * k) = jk;
-    innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
-    noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
+    if (!PredictMeasurement(camera, z, &predicted, &jk)) return UpdateStatus::kNotInFront;
+    l->h.middleRows<2>(2 * k) = jk;
+    l->innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
+    l->noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
   }
-  return Correct(h, innovation, noise);
+  return l->innovation.allFinite() ? UpdateStatus::kOk : UpdateStatus::kNonFinite;
 }
 
-double Filter::Correct(const Eigen::MatrixXd& h, const Eigen::VectorXd& innovation, const Eigen::VectorXd& noise) {
-  const Eigen::MatrixXd ph_t = covariance_ * h.transpose();
-  Eigen::MatrixXd s = h * ph_t;
+UpdateStatus Filter::ComputeGain(const Eigen::MatrixXd& h, const Eigen::VectorXd& noise, Gain* g) const {
+  g->ph_t = covariance_ * h.transpose();
+  Eigen::MatrixXd s = h * g->ph_t;
   s.diagonal() += noise;
-  const Eigen::LLT<Eigen::MatrixXd> llt(s);
-  PDVO_THROW_CHECK(llt.info() == Eigen::Success, InvalidArgument, "filter: innovation covariance not positive");
-  const Eigen::MatrixXd gain_t = llt.solve(ph_t.transpose());  // K^T = S^-1 H P
-  const double nis = innovation.dot(llt.solve(innovation));
-  Apply(gain_t.transpose() * innovation);
-  covariance_ -= ph_t * gain_t;  // P - K H P
+  g->llt.compute(s);
+  if (g->llt.info() != Eigen::Success) return UpdateStatus::kNotPositive;
+  g->gain_t = g->llt.solve(g->ph_t.transpose());  // K^T = S^-1 H P
+  return UpdateStatus::kOk;
+}
+
+UpdateResult Filter::Update(const Camera& camera, const std::vector<PointMeasurement>& measurements) {
+  Linearised l;
+  const UpdateStatus status = Linearise(camera, measurements, &l);
+  if (status != UpdateStatus::kOk) return {status, 0};
+  return Correct(l);
+}
+
+UpdateStatus Filter::Step(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                          Eigen::VectorXd* step) const {
+  Linearised l;
+  Gain g;
+  UpdateStatus status = Linearise(camera, measurements, &l);
+  if (status == UpdateStatus::kOk) status = ComputeGain(l.h, l.noise, &g);
+  if (status != UpdateStatus::kOk) return status;
+  Eigen::VectorXd delta = g.gain_t.transpose() * l.innovation;
+  if (!delta.allFinite()) return UpdateStatus::kNonFinite;
+  *step = std::move(delta);
+  return UpdateStatus::kOk;
+}
+
+UpdateResult Filter::Correct(const Linearised& l) {
+  Gain g;
+  const UpdateStatus status = ComputeGain(l.h, l.noise, &g);
+  if (status != UpdateStatus::kOk) return {status, 0};
+  const double nis = l.innovation.dot(g.llt.solve(l.innovation));
+  const Eigen::VectorXd delta = g.gain_t.transpose() * l.innovation;
+  if (!delta.allFinite()) return {UpdateStatus::kNonFinite, 0};
+  Apply(delta);
+  covariance_ -= g.ph_t * g.gain_t;  // P - K H P
   covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
-  return nis;
+  return {UpdateStatus::kOk, nis};
+}
+
+void Filter::PredictAfter(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                          const Eigen::VectorXd& step, std::vector<Eigen::Vector2d>* pixels,
+                          std::vector<bool>* predicted) const {
+  PDVO_THROW_CHECK(step.size() == size(), InvalidArgument, "filter: a step of the wrong size");
+  // The moved camera and reference cameras, computed as Apply computes them.
+  const Rigid3d current = camera_.Plus(step.head<12>()).world_from_cam();
+  std::map<int, Rigid3d> references;
+  for (const auto& [id, r] : references_) {
+    references[id] = Rigid3d(r.world_from_cam.rotation * ExpSO3(step.segment<3>(r.offset + 3)),
+                             r.world_from_cam.translation + step.segment<3>(r.offset));
+  }
+  pixels->assign(measurements.size(), Eigen::Vector2d::Zero());
+  predicted->assign(measurements.size(), false);
+  for (size_t k = 0; k < measurements.size(); ++k) {
+    const PointMeasurement& z = measurements[k];
+    Eigen::Vector2d& pixel = (*pixels)[k];
+    if (const auto plane = planes_.find(z.point); plane != planes_.end()) {
+      const Plane& p = plane->second;
+      InversePlane moved = p.plane;
+      moved.normal += step.segment<3>(p.offset);
+      moved.inverse_distance += step[p.offset + 3];
+      (*predicted)[k] = ProjectPlanePoint(camera, current, references.at(p.reference), moved, z.ray, &pixel);
+    } else {
+      const Point& p = points_.at(z.point);
+      (*predicted)[k] = ProjectInverseDepth(camera, current, references.at(p.reference), p.ray,
+                                            p.inverse_depth + step[p.offset], &pixel);
+    }
+  }
 }
 
 void Filter::Apply(const Eigen::VectorXd& delta) {

@@ -1,20 +1,8 @@
 #include "pdvo/vo/idpp.h"
 
+#include <opencv2/core/eigen.hpp>
+
 namespace pdvo::vo {
-
-Eigen::Matrix3d Pinhole::K() const {
-  Eigen::Matrix3d k;
-  k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
-  return k;
-}
-
-Eigen::Vector2d Pinhole::Project(const Eigen::Vector3d& p) const {
-  return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
-}
-
-Eigen::Vector3d Pinhole::Ray(const Eigen::Vector2d& pixel) const {
-  return Eigen::Vector3d((pixel.x() - cx) / fx, (pixel.y() - cy) / fy, 1).normalized();
-}
 
 double InversePlane::InverseDepthAlong(const Eigen::Vector3d& ray) const {
   return -inverse_distance * normal.normalized().dot(ray);
@@ -29,7 +17,7 @@ Eigen::RowVector4d InversePlane::InverseDepthJacobian(const Eigen::Vector3d& ray
   return j;
 }
 
-bool ProjectInverseDepth(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+bool ProjectInverseDepth(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                          const Eigen::Vector3d& ray, double rho, Eigen::Vector2d* pixel, ProjectionJacobians* j) {
   const Eigen::Matrix3d rc_t = world_from_current.rotation.toRotationMatrix().transpose();
   const Eigen::Matrix3d rr = world_from_ref.rotation.toRotationMatrix();
@@ -47,7 +35,7 @@ bool ProjectInverseDepth(const Pinhole& camera, const Rigid3d& world_from_curren
   return true;
 }
 
-bool ProjectPlanePoint(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+bool ProjectPlanePoint(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                        const InversePlane& plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                        ProjectionJacobians* j, Eigen::Matrix<double, 2, 4>* plane_jacobian) {
   const double rho = plane.InverseDepthAlong(ray);
@@ -57,10 +45,11 @@ bool ProjectPlanePoint(const Pinhole& camera, const Rigid3d& world_from_current,
   return true;
 }
 
-Eigen::Matrix3d PlaneHomography(const Pinhole& camera, const Rigid3d& world_from_current,
+Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current,
                                 const Rigid3d& world_from_ref, const InversePlane& plane) {
   const Rigid3d current_from_ref = world_from_current.Inverse() * world_from_ref;
-  const Eigen::Matrix3d k = camera.K();
+  Eigen::Matrix3d k;
+  cv::cv2eigen(camera.K(), k);
   const Eigen::Matrix3d euclidean = current_from_ref.rotation.toRotationMatrix() -
                                     plane.inverse_distance * current_from_ref.translation *
                                         plane.normal.normalized().transpose();

@@ -1,6 +1,13 @@
 #include "pdvo/vo/motion.h"
 
+#include "pdvo/common/options.h"
+
 namespace pdvo::vo {
+
+bool MotionNoise::Check() const {
+  PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
+  return true;
+}
 
 CameraState CameraState::Plus(const Vector12d& d) const {
   CameraState s;

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "pdvo/common/camera.h"
+
 namespace pdvo {
 
 inline constexpr const char* kPlaneLabel = "plane";
@@ -29,15 +31,13 @@ struct AnnotationShape {
   bool IsNonPlane() const { return label == kNonPlaneLabel; }
 };
 
-struct AnnotationCamera {
-  double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels, at the image's full resolution
-};
-
 struct Annotation {
   std::string version = "5.2.1";  // LabelMe version string
   std::string image_path;         // relative to the JSON file's folder
   int image_width = 0, image_height = 0;
-  std::optional<AnnotationCamera> camera;
+  // The image's pinhole camera at its full resolution: the file holds fx, fy, cx, cy (px); width and height are
+  // the image's, and there is no distortion.
+  std::optional<Camera> camera;
   std::vector<AnnotationShape> shapes;
   nlohmann::json extra = nlohmann::json::object();  // other top-level keys (flags, ...), kept as read
 };

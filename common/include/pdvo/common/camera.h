@@ -39,6 +39,8 @@ struct Camera {
   Eigen::Vector2d Project(const Eigen::Vector3d& point_in_cam) const;
   // The viewing ray (z = 1) of a distorted pixel: undistorts iteratively.
   Eigen::Vector3d Unproject(const Eigen::Vector2d& pixel) const;
+  // The same ray as a unit vector.
+  Eigen::Vector3d Ray(const Eigen::Vector2d& pixel) const;
   // Maps distorted pixels to the pixels of the ideal pinhole camera with the same K.
   std::vector<cv::Point2d> UndistortPoints(const std::vector<cv::Point2d>& pixels) const;
 
@@ -46,6 +48,8 @@ struct Camera {
   Camera Undistorted() const;
   // The camera of the image resized to width x height (pixel centres map to pixel centres).
   Camera Rescaled(int new_width, int new_height) const;
+  // A pinhole camera without distortion.
+  static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
   // A pinhole camera without distortion with the given horizontal field of view, square pixels and the
   // principal point at the image's centre.
   static Camera WithFieldOfView(int width, int height, double horizontal_fov_deg);

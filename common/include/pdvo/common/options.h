@@ -15,7 +15,13 @@
 //
 // From that one list come reading (absent keys keep their defaults; unknown keys and wrong types throw
 // FormatError naming the file and the key), writing, and `--set key.sub=value` overrides.
-// Field types: bool, int, double, std::string, std::vector<double>, and nested options structs.
+// Field types: bool, int, double, std::string, std::vector<double>, nested options structs, and enums that
+// name their values with a function found by argument-dependent lookup, as text in YAML and in `--set`:
+//
+//   enum class Shape { kSquare, kRound };
+//   constexpr std::array<std::pair<Shape, const char*>, 2> OptionNames(Shape) {
+//     return {{{Shape::kSquare, "square"}, {Shape::kRound, "round"}}};
+//   }
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -39,6 +45,28 @@ struct FieldProbe {
 
 template <class T>
 concept OptionsStruct = requires(T& t, detail::FieldProbe& probe) { T::Fields(t, probe); };
+
+// An enum whose values have names (OptionNames, above).
+template <class T>
+concept OptionsEnum = std::is_enum_v<T> && requires(T t) { OptionNames(t); };
+
+// The name of an enum value, and the value of a name (InvalidArgument naming `where` and the names if unknown).
+template <OptionsEnum T>
+std::string OptionName(T value) {
+  for (const auto& [v, name] : OptionNames(value)) {
+    if (v == value) return name;
+  }
+  return "?";
+}
+template <OptionsEnum T>
+T OptionValue(const std::string& text, const std::string& where) {
+  std::string names;
+  for (const auto& [v, name] : OptionNames(T{})) {
+    if (text == name) return v;
+    names += (names.empty() ? "" : ", ") + std::string(name);
+  }
+  PDVO_THROW(InvalidArgument, where << ": '" << text << "' is not one of " << names);
+}
 
 namespace detail {
 // The first condition that failed in a PDVO_CHECK_OPTION since it was last cleared (per thread): the innermost
@@ -86,8 +114,17 @@ void ReadOptions(const cv::FileNode& node, T& options, const std::string& where)
     const cv::FileNode child = node[key];
     if (child.empty() || child.isNone()) return;
     const std::string child_where = where + "." + key;
-    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (OptionsStruct<Field>) {
       ReadOptions(child, field, child_where);
+    } else if constexpr (OptionsEnum<Field>) {
+      std::string text;
+      detail::ReadScalar(child, child_where, text);
+      try {
+        field = OptionValue<Field>(text, child_where);
+      } catch (const InvalidArgument& e) {
+        PDVO_THROW(FormatError, e.what());
+      }
     } else {
       detail::ReadScalar(child, child_where, field);
     }
@@ -100,10 +137,13 @@ void ReadOptions(const cv::FileNode& node, T& options, const std::string& where)
 template <OptionsStruct T>
 void WriteOptions(cv::FileStorage& fs, const T& options) {
   auto visit = [&](const char* key, const auto& field) {
-    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (OptionsStruct<Field>) {
       fs << key << "{";
       WriteOptions(fs, field);
       fs << "}";
+    } else if constexpr (OptionsEnum<Field>) {
+      detail::WriteScalar(fs, key, OptionName(field));
     } else {
       detail::WriteScalar(fs, key, field);
     }
@@ -121,13 +161,18 @@ void SetOption(T& options, const std::string& key, const std::string& value) {
   auto visit = [&](const char* name, auto& field) {
     if (head != name) return;
     found = true;
-    if constexpr (OptionsStruct<std::remove_cvref_t<decltype(field)>>) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (OptionsStruct<Field>) {
       PDVO_THROW_CHECK(dot != std::string::npos, InvalidArgument,
                        "option '" << key << "' is a group; name one of its fields");
       SetOption(field, key.substr(dot + 1), value);
     } else {
       PDVO_THROW_CHECK(dot == std::string::npos, InvalidArgument, "unknown option '" << key << "'");
-      detail::ParseScalar(value, key, field);
+      if constexpr (OptionsEnum<Field>) {
+        field = OptionValue<Field>(value, key);
+      } else {
+        detail::ParseScalar(value, key, field);
+      }
     }
   };
   T::Fields(options, visit);

@@ -2,23 +2,35 @@
 // poses of keyframes at which features were initialised, shared by those features), and inverse-depth points
 // and planes anchored at them (idpp.h), with one dense covariance over the error state
 //   [camera 12 | per reference camera 6 (dp, dtheta) | per point 1 (rho) | per plane 4 (n, rho_p)]
-// in the order they were added. A plane's points are keyframe rays outside the state: a plane costs four
-// values however many points it holds. Features and reference cameras are named by ids (one sequence for all)
-// that stay valid while the rest of the state changes.
+// in the order they were added. A plane's points are keyframe rays outside the state: a plane costs four values
+// however many points it holds. Features and reference cameras are named by ids (one sequence for all) that
+// stay valid while the rest of the state changes. Cameras are pdvo::Camera without distortion; pixels theirs.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <map>
 #include <vector>
 
+#include "pdvo/common/camera.h"
 #include "pdvo/vo/idpp.h"
 #include "pdvo/vo/motion.h"
 
 namespace pdvo::vo {
 
-struct MotionNoise {
-  double linear_acceleration = 2.0;   // m/s^2, standard deviation
-  double angular_acceleration = 2.0;  // rad/s^2
+// What became of an update. Per-frame failures are values: the filter is left as it was unless kOk.
+enum class UpdateStatus {
+  kOk,
+  kNoMeasurements,   // nothing to update with
+  kNotInFront,       // a measured feature is not in front of the camera (no prediction)
+  kNotPositive,      // the innovation covariance is not positive definite (numerically)
+  kNonFinite,        // the step or the innovation is not finite
+};
+const char* ToString(UpdateStatus status);  // "ok", "no-measurements", "not-in-front", "not-positive", "non-finite"
+struct UpdateResult {
+  UpdateStatus status = UpdateStatus::kOk;
+  double nis = 0;  // normalised innovation squared (chi-square with 2 x count degrees of freedom) when kOk
+  bool ok() const { return status == UpdateStatus::kOk; }
 };
 
 // One pixel measurement of a point, or of one of a plane's points (given by its keyframe ray).
@@ -57,13 +69,13 @@ class Filter {
   const std::map<int, Point>& points() const { return points_; }
   const std::map<int, Plane>& planes() const { return planes_; }
 
-  // Constant velocity over dt seconds (PredictCamera), with its process noise.
+  // Constant velocity over dt seconds (PredictCamera), with its process noise. Throws for dt < 0.
   void Predict(double dt, const MotionNoise& noise);
 
   // A reference camera at the current camera's pose. Tracked (fixed = false): it takes the camera pose's
   // covariance and correlations, and later updates move it with the camera. Fixed: the pose is taken as exact
   // (no variance, no correlation), so no update moves it: the map's frame is fixed again at each keyframe, as
-  // the first camera's is at the start. See VoOptions::fixed_references for why.
+  // the first camera's is at the start (docs/odometry.md says why).
   int AddReference(bool fixed);
   // A point on the ray (unit, reference frame) at inverse depth rho with standard deviation sigma_rho,
   // uncorrelated with the rest of the state.
@@ -78,31 +90,53 @@ class Filter {
   int PlaneToPoint(int plane, const Eigen::Vector3d& ray);
   // A point of the plane's reference camera joins the plane: what the point's inverse depth says is fused into
   // the plane (an update with the constraint rho_point = rho_plane(ray), standard deviation `sigma` in inverse
-  // depth: how far off the plane a point may be), then the point leaves the state.
-  void MergePointIntoPlane(int point, int plane, double sigma);
+  // depth: how far off the plane a point may be), then the point leaves the state. If the fusion fails (not
+  // kOk), nothing changes and the point stays.
+  UpdateStatus MergePointIntoPlane(int point, int plane, double sigma);
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.
-  bool PredictPoint(const Pinhole& camera, int point, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const;
+  bool PredictPoint(const Camera& camera, int point, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const;
   // The same for the point of a plane on `ray`; false also if the ray does not meet the plane in front.
-  bool PredictPlanePoint(const Pinhole& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
+  bool PredictPlanePoint(const Camera& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                          Eigen::MatrixXd* jacobian) const;
 
   // The predicted pixel of a measurement's feature (a point, or the plane point on its ray), as above.
-  bool PredictMeasurement(const Pinhole& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
+  bool PredictMeasurement(const Camera& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
                           Eigen::MatrixXd* jacobian) const;
 
-  // One batched EKF update with the measurements (points must exist and be in front of the camera); returns
-  // the normalised innovation squared of the batch (chi-square with 2 x count degrees of freedom).
-  double Update(const Pinhole& camera, const std::vector<PointMeasurement>& measurements);
+  // One batched EKF update with the measurements (their features must exist).
+  UpdateResult Update(const Camera& camera, const std::vector<PointMeasurement>& measurements);
+  // The step (size()) that Update would add to the state, computed without changing the filter or copying its
+  // covariance: 1-point RANSAC's hypotheses (robust_update.h). `step` is set only when kOk.
+  UpdateStatus Step(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                    Eigen::VectorXd* step) const;
+  // The predicted pixels of the measurements' features as PredictMeasurement would give them after
+  // Apply(step), without changing the filter; `predicted[k]` is false where there is no prediction.
+  void PredictAfter(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                    const Eigen::VectorXd& step, std::vector<Eigen::Vector2d>* pixels,
+                    std::vector<bool>* predicted) const;
 
-  // Adds `delta` (size()) to the state: the camera and reference cameras on their manifolds.
+  // Adds `delta` (size()) to the state: the camera and reference cameras on their manifolds. Throws if
+  // `delta` has the wrong size or is not finite.
   void Apply(const Eigen::VectorXd& delta);
 
  private:
-  // The EKF correction for measurements with Jacobian `h` (rows x size()), `innovation` (measured - predicted)
-  // and independent noise variances; returns the normalised innovation squared.
-  double Correct(const Eigen::MatrixXd& h, const Eigen::VectorXd& innovation, const Eigen::VectorXd& noise);
+  // The stacked Jacobian (2 count x size()), innovation (measured - predicted) and noise variances.
+  struct Linearised {
+    Eigen::MatrixXd h;
+    Eigen::VectorXd innovation, noise;
+  };
+  UpdateStatus Linearise(const Camera& camera, const std::vector<PointMeasurement>& measurements,
+                         Linearised* out) const;
+  // The Kalman gain's parts for Jacobian `h` and noise variances: P H^T and K^T = S^-1 H P, with S's factor.
+  struct Gain {
+    Eigen::MatrixXd ph_t, gain_t;
+    Eigen::LLT<Eigen::MatrixXd> llt;
+  };
+  UpdateStatus ComputeGain(const Eigen::MatrixXd& h, const Eigen::VectorXd& noise, Gain* gain) const;
+  // The EKF correction with a linearisation: the state moves by K innovation and P becomes P - K H P.
+  UpdateResult Correct(const Linearised& l);
   void Remove(std::vector<int> dropped, int reference);
   void Renumber();
   // Grows the covariance by variances.size() rows and columns, zero but for `variances` on the new diagonal.

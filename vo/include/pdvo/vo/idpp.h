@@ -7,25 +7,20 @@
 // plane): n^ . point_in_ref + 1 / rho_p = 0. A plane's point is its keyframe ray alone; its inverse depth is
 // where the ray meets the plane, rho = -rho_p (n^ . m). A point costs one state value, a plane four.
 //
-// Measurements are pixels of the current camera (pinhole, undistorted). Jacobians are with respect to the
-// error states: a camera's (dp, dtheta) as in motion.h (position in the world, rotation perturbed on the right).
+// Measurements are pixels of the current camera, a pdvo::Camera without distortion (the working camera of
+// FramePreparer, frames.h). Jacobians are with respect to the error states: a camera's (dp, dtheta) as in
+// motion.h (position in the world, rotation perturbed on the right).
 #pragma once
 
 #include <Eigen/Core>
 
+#include "pdvo/common/camera.h"
 #include "pdvo/common/geometry.h"
 
 namespace pdvo::vo {
 
 using Matrix23d = Eigen::Matrix<double, 2, 3>;
 using Matrix26d = Eigen::Matrix<double, 2, 6>;
-
-struct Pinhole {
-  double fx = 0, fy = 0, cx = 0, cy = 0;
-  Eigen::Matrix3d K() const;
-  Eigen::Vector2d Project(const Eigen::Vector3d& point_in_cam) const;
-  Eigen::Vector3d Ray(const Eigen::Vector2d& pixel) const;  // unit
-};
 
 struct InversePlane {
   Eigen::Vector3d normal;  // towards the reference camera; not necessarily unit
@@ -46,18 +41,18 @@ struct ProjectionJacobians {
 // The pixel at which the current camera sees the point (ray, rho) of the reference camera; nothing (false) if it
 // lies behind the current camera. h = R_c^T (rho (p_r - p_c) + R_r m) is the point scaled by rho, which stays
 // finite as rho -> 0 (points at infinity).
-bool ProjectInverseDepth(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+bool ProjectInverseDepth(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                          const Eigen::Vector3d& ray, double inverse_depth, Eigen::Vector2d* pixel,
                          ProjectionJacobians* jacobians = nullptr);
 
 // The same for a plane's point: its rho comes from the plane; `plane_jacobian` (2x4) is w.r.t. (n, rho_p).
-bool ProjectPlanePoint(const Pinhole& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+bool ProjectPlanePoint(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                        const InversePlane& plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                        ProjectionJacobians* jacobians = nullptr, Eigen::Matrix<double, 2, 4>* plane_jacobian = nullptr);
 
 // The homography taking reference pixels to current pixels for points of the plane:
 // H = K (R_cr - rho_p t_cr n^T) K^-1, with (R_cr, t_cr) = current_from_ref.
-Eigen::Matrix3d PlaneHomography(const Pinhole& camera, const Rigid3d& world_from_current,
+Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current,
                                 const Rigid3d& world_from_ref, const InversePlane& plane);
 // A point's patch is taken as fronto-parallel: the plane through it facing its reference camera.
 InversePlane FrontoParallel(const Eigen::Vector3d& ray, double inverse_depth);

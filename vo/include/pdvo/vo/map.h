@@ -1,14 +1,22 @@
-// What the visual odometry mapped: points whose inverse depth was known to 30% and planes (as the polygon of
-// their points, in the world), kept when they leave the filter; and writing it with the camera path as PLY.
+// What the visual odometry mapped, in the world frame: points whose inverse depth is known to 30% and planes as
+// the polygon of their points (the convex hull of their keyframe pixels, on the plane), kept when they leave the
+// filter; the paper's mapping statistics (Table I: planes, points per plane, plane area); and writing the map
+// with the camera path as PLY.
 #pragma once
 
 #include <Eigen/Core>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pdvo/common/trajectory.h"
 
 namespace pdvo::vo {
+
+class Filter;
+struct PlaneTrack;
+struct Tracks;
 
 struct MapPlane {
   std::vector<Eigen::Vector3d> polygon;  // world, in order around the plane's points' convex hull
@@ -24,6 +32,56 @@ struct Map {
     planes.insert(planes.end(), other.planes.begin(), other.planes.end());
   }
 };
+
+// A plane as mapped: its most points and the largest area (convex hull of its points, keyframe pixels).
+struct PlaneRecord {
+  int points = 0;
+  double area = 0;
+};
+// The paper's Table I: planes made (that reached min_plane_points), mean points per plane, mean plane area.
+struct MappingStats {
+  int planes = 0;
+  double points_per_plane = 0;
+  double mean_plane_area = 0;  // px^2, working resolution
+};
+
+// The share of its inverse depth within which a point's is known (one standard deviation) for it to be mapped.
+inline constexpr double kMappedRelativeSigma = 0.3;
+// True, with its world position, if point `id` of the filter is known to kMappedRelativeSigma.
+bool PointInWorld(const Filter& filter, int id, Eigen::Vector3d* point_in_world);
+// Plane `id` of the filter with track `track` as a polygon in the world; false if it has fewer than
+// `min_points` points or one of its hull's rays does not meet it in front.
+bool PlaneInWorld(const Filter& filter, int id, const PlaneTrack& track, int min_points, MapPlane* plane);
+// The area (keyframe px^2) of the convex hull of a plane's points' keyframe pixels.
+double PlaneArea(const PlaneTrack& track);
+
+// The record of a run: what left the filters, and every plane that reached min_plane_points. Each start of the
+// odometry is a new filter, whose ids start again (NewFilter).
+class MapRecord {
+ public:
+  explicit MapRecord(int min_plane_points) : min_plane_points_(min_plane_points) {}
+  void NewFilter() { ++generation_; }
+  // A plane's size now: its record keeps the most points and the largest area (if it has min_plane_points).
+  void Record(int plane_id, const PlaneTrack& track);
+  // Keeps what a feature that leaves the filter has mapped.
+  void KeepPoint(const Filter& filter, int id);
+  void KeepPlane(const Filter& filter, int id, const PlaneTrack& track);
+  // Keeps everything in the filter now (before a restart).
+  void KeepAll(const Filter& filter, const Tracks& tracks);
+
+  const Map& kept() const { return kept_; }
+  MappingStats stats() const;
+  int min_plane_points() const { return min_plane_points_; }
+
+ private:
+  int min_plane_points_;
+  int generation_ = 0;
+  std::map<std::pair<int, int>, PlaneRecord> records_;  // by (generation, plane id)
+  Map kept_;
+};
+
+// The features in the filter now, as map entries.
+Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points);
 
 // ASCII PLY: vertices (x y z and an RGB colour: points grey, plane corners coloured by their normal, camera
 // positions red), one face per plane polygon, and one edge per step of the camera path. Written atomically.

@@ -15,6 +15,20 @@ namespace pdvo::vo {
 using Matrix12d = Eigen::Matrix<double, 12, 12>;
 using Vector12d = Eigen::Matrix<double, 12, 1>;
 
+// The constant-velocity model's process noise: standard deviations of the random accelerations.
+struct MotionNoise {
+  double linear_acceleration = 0.25;  // m/s^2
+  double angular_acceleration = 4.0;  // rad/s^2
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("linear_acceleration", self.linear_acceleration);
+    visit("angular_acceleration", self.angular_acceleration);
+  }
+  bool Check() const;
+  bool operator==(const MotionNoise&) const = default;
+};
+
 struct CameraState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();                  // camera centre in the world
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();     // world_from_cam rotation

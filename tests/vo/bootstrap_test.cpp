@@ -1,0 +1,116 @@
+// The two-view bootstrap's geometry on generated correspondences with known motion: the motion's rotation and
+// direction are found, the triangulated points are the true ones at the asked scale, and views without parallax
+// (a pure rotation) are refused.
+#include "pdvo/vo/bootstrap.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace pdvo::vo {
+namespace {
+
+const Camera kCamera = Camera::Pinhole(320, 240, 277, 277, 159.5, 119.5);
+
+// Points 3-12 m in front of the first camera, seen by both; pixels exact.
+struct TwoViews {
+  std::vector<Eigen::Vector3d> points;  // first camera's frame
+  std::vector<cv::Point2f> first, second;
+};
+TwoViews Generate(const Rigid3d& first_from_second, int n, unsigned seed) {
+  TwoViews v;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1), depth(3, 12);
+  const Rigid3d second_from_first = first_from_second.Inverse();
+  while (static_cast<int>(v.points.size()) < n) {
+    const double z = depth(rng);
+    const Eigen::Vector3d x(0.5 * z * u(rng), 0.4 * z * u(rng), z);
+    const Eigen::Vector3d in_second = second_from_first * x;
+    if (in_second.z() < 1) continue;
+    const Eigen::Vector2d a = kCamera.Project(x), b = kCamera.Project(in_second);
+    if (b.x() < 0 || b.y() < 0 || b.x() > 319 || b.y() > 239) continue;
+    v.points.push_back(x);
+    v.first.emplace_back(a.x(), a.y());
+    v.second.emplace_back(b.x(), b.y());
+  }
+  return v;
+}
+
+TEST(Bootstrap, FindsAKnownMotion) {
+  // Forward and to the right by 0.8 m, turning 4 degrees to the left.
+  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(-4 * M_PI / 180, Eigen::Vector3d::UnitY())),
+                      Eigen::Vector3d(0.6, 0.05, 0.53));
+  const TwoViews v = Generate(truth, 150, 3);
+  TwoViewMotion motion;
+  constexpr double kInverseDepth = 0.2;
+  ASSERT_TRUE(EstimateTwoView(kCamera, v.first, v.second, 1.5, kInverseDepth, &motion));
+  EXPECT_GT(motion.inliers.size(), 140u);
+  EXPECT_LT(LogSO3(truth.rotation.conjugate() * motion.first_from_second.rotation).norm() * 180 / M_PI, 0.05);
+  const double angle = std::acos(std::clamp(
+      truth.translation.normalized().dot(motion.first_from_second.translation.normalized()), -1.0, 1.0));
+  EXPECT_LT(angle * 180 / M_PI, 0.1);
+  // The points are the true ones at one scale, the one that puts their median distance at 1 / inverse depth.
+  const double scale = motion.first_from_second.translation.norm() / truth.translation.norm();
+  std::vector<double> distances;
+  const Rigid3d second_from_first = motion.first_from_second.Inverse();
+  for (size_t j = 0; j < motion.inliers.size(); ++j) {
+    const Eigen::Vector3d& x = v.points[motion.inliers[j]];
+    EXPECT_LT((motion.points[j] - scale * x).norm(), 1e-3 * scale * x.norm()) << j;
+    distances.push_back((second_from_first * motion.points[j]).norm());
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  EXPECT_NEAR(distances[distances.size() / 2], 1 / kInverseDepth, 1e-9);
+}
+
+TEST(Bootstrap, RefusesViewsWithoutParallax) {
+  const Rigid3d turn(Eigen::Quaterniond(Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitY())),
+                     Eigen::Vector3d::Zero());
+  const TwoViews v = Generate(turn, 150, 4);
+  TwoViewMotion motion;
+  EXPECT_FALSE(EstimateTwoView(kCamera, v.first, v.second, 1.5, 0.2, &motion));
+  const TwoViews few = Generate(Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.5, 0, 0)), 20, 5);
+  EXPECT_FALSE(EstimateTwoView(kCamera, few.first, few.second, 1.5, 0.2, &motion));  // too few to trust
+}
+
+// The bootstrap on frames: a textured wall seen while the camera slides sideways; it starts once the
+// parallax suffices, with the motion's direction, and revises the poses of the frames in between.
+TEST(Bootstrap, StartsOnFramesOfASlidingCamera) {
+  cv::Mat wall(600, 900, CV_8U);
+  cv::RNG rng(11);
+  rng.fill(wall, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(wall, wall, cv::Size(0, 0), 2.0);
+  cv::normalize(wall, wall, 0, 255, cv::NORM_MINMAX);
+  // A fronto-parallel wall 4 m away, the camera sliding 2 cm a frame to the right: the image moves left
+  // by 277 * 0.02 / 4 = 1.385 px a frame. Parallax grows with the baseline (1.5 degrees: about 0.1 m).
+  BootstrapOptions options;
+  TwoViewBootstrap bootstrap(kCamera, options, 10, 12, 0.25);
+  std::optional<BootstrapStart> start;
+  int frame = 0;
+  // A flat wall is a degenerate scene for the essential matrix; a second, nearer layer (a 1 m deep offset on
+  // the left half) gives it depth.
+  for (; frame < 60 && !start; ++frame) {
+    const double shift = 1.385 * frame;
+    cv::Mat image(240, 320, CV_8U);
+    for (int y = 0; y < 240; ++y) {
+      for (int x = 0; x < 320; ++x) {
+        const bool near = x < 160;
+        const double s = near ? shift * 4 / 3 : shift;  // the near layer (3 m) moves faster
+        image.at<uchar>(y, x) = wall.at<uchar>(y + 100 + (near ? 200 : 0), std::clamp(cvRound(x + 200 + s), 0, 899));
+      }
+    }
+    if (frame == 0) {
+      bootstrap.Begin(image, 0.0, 0, CameraState());
+      ASSERT_TRUE(bootstrap.active());
+    } else {
+      start = bootstrap.Step(image, frame / 30.0);
+    }
+  }
+  ASSERT_TRUE(start.has_value()) << "no start after " << frame << " frames";
+  EXPECT_FALSE(bootstrap.active());
+  EXPECT_GT(start->camera.position.normalized().x(), 0.95) << start->camera.position.transpose();
+  EXPECT_GT(start->corners.size(), kBootstrapInliers);
+  EXPECT_EQ(start->revised.size(), static_cast<size_t>(frame - 2));  // the frames between the first and now
+}
+
+}  // namespace
+}  // namespace pdvo::vo

@@ -1,0 +1,169 @@
+#include "pdvo/vo/bootstrap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "pdvo/common/logging.h"
+#include "pdvo/common/options.h"
+
+namespace pdvo::vo {
+namespace {
+
+// Lucas-Kanade: window (px) and pyramid levels above the image.
+const cv::Size kFlowWindow(21, 21);
+constexpr int kFlowLevels = 3;
+// The essential matrix: RANSAC confidence and inlier distance (px); triangulated points farther than this
+// (in units of the baseline) are dropped as at infinity.
+constexpr double kRansacConfidence = 0.999;
+constexpr double kRansacThreshold = 1.0;
+constexpr double kFarthest = 1e6;
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+bool BootstrapOptions::Check() const {
+  PDVO_CHECK_OPTION(frames >= 0 && parallax > 0 && velocity_sigma > 0);
+  return true;
+}
+
+bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                     double parallax_deg, double inverse_depth, TwoViewMotion* motion) {
+  if (from.size() < kBootstrapInliers || from.size() != to.size()) return false;
+  cv::Mat inliers;
+  const cv::Mat e =
+      cv::findEssentialMat(from, to, camera.K(), cv::RANSAC, kRansacConfidence, kRansacThreshold, inliers);
+  if (e.rows != 3 || e.cols != 3) return false;
+  cv::Mat r, t, triangulated;
+  cv::recoverPose(e, from, to, camera.K(), r, t, kFarthest, inliers, triangulated);
+  // x_second = R x_first + t, |t| = 1.
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  cv::cv2eigen(r, rotation);
+  cv::cv2eigen(t, translation);
+  triangulated.convertTo(triangulated, CV_64F);
+  const Eigen::Vector3d centre = -rotation.transpose() * translation;  // of the second camera, first frame
+  std::vector<double> parallax, distance;
+  motion->inliers.clear();
+  motion->points.clear();
+  for (int i = 0; i < inliers.rows; ++i) {
+    if (!inliers.at<uchar>(i)) continue;
+    const Eigen::Vector4d h(triangulated.at<double>(0, i), triangulated.at<double>(1, i),
+                            triangulated.at<double>(2, i), triangulated.at<double>(3, i));
+    if (std::abs(h(3)) < 1e-12) continue;
+    const Eigen::Vector3d x = h.hnormalized();
+    const Eigen::Vector3d in_second = rotation * x + translation;
+    if (x.z() <= 0 || in_second.z() <= 0) continue;
+    parallax.push_back(std::acos(std::clamp(x.normalized().dot((x - centre).normalized()), -1.0, 1.0)));
+    distance.push_back(in_second.norm());
+    motion->inliers.push_back(i);
+    motion->points.push_back(x);
+  }
+  const size_t n = motion->inliers.size();
+  if (n < kBootstrapInliers || 2 * n < to.size()) return false;
+  if (Median(parallax) < parallax_deg * M_PI / 180) return false;
+  const double scale = 1 / (inverse_depth * Median(distance));
+  for (Eigen::Vector3d& x : motion->points) x *= scale;
+  motion->first_from_second = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre * scale);
+  return true;
+}
+
+TwoViewBootstrap::TwoViewBootstrap(const Camera& camera, const BootstrapOptions& options, int border,
+                                   double min_distance, double inverse_depth)
+    : camera_(camera), o_(options), border_(border), min_distance_(min_distance), inverse_depth_(inverse_depth) {}
+
+void TwoViewBootstrap::Stop() {
+  active_ = false;
+  tracks_.clear();
+  previous_ = cv::Mat();
+}
+
+void TwoViewBootstrap::Begin(const cv::Mat& grey, double timestamp, size_t index, const CameraState& first) {
+  Stop();
+  if (o_.frames == 0) return;
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(grey, corners, kBootstrapCorners, kCornerQuality, min_distance_,
+                          InsideMask(grey.size(), border_));
+  active_ = corners.size() >= kBootstrapInliers;
+  tracks_ = {corners};
+  previous_ = grey.clone();
+  time_ = timestamp;
+  index_ = index;
+  first_ = first;
+}
+
+std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double timestamp) {
+  if (!active_) return std::nullopt;
+  std::vector<cv::Point2f> next;
+  std::vector<uchar> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(previous_, grey, tracks_.back(), next, status, error, kFlowWindow, kFlowLevels);
+  tracks_.push_back(next);
+  size_t kept = 0;
+  for (size_t i = 0; i < next.size(); ++i) {
+    if (!status[i] || !Inside(Eigen::Vector2d(next[i].x, next[i].y), grey.size(), border_)) continue;
+    for (std::vector<cv::Point2f>& frame : tracks_) frame[kept] = frame[i];
+    ++kept;
+  }
+  for (std::vector<cv::Point2f>& frame : tracks_) frame.resize(kept);
+  previous_ = grey.clone();
+  if (kept < kBootstrapInliers || static_cast<int>(tracks_.size()) > o_.frames + 1) {
+    Stop();
+    return std::nullopt;
+  }
+  TwoViewMotion motion;
+  if (!EstimateTwoView(camera_, tracks_.front(), tracks_.back(), o_.parallax, inverse_depth_, &motion)) {
+    return std::nullopt;
+  }
+  const Rigid3d& first_from_current = motion.first_from_second;
+  BootstrapStart start;
+  CameraState& at = start.camera;
+  const Rigid3d world_from_first = first_.world_from_cam();
+  const Rigid3d world_from_current = world_from_first * first_from_current;
+  at.position = world_from_current.translation;
+  at.orientation = world_from_current.rotation;
+  const double dt = timestamp - time_;
+  at.velocity = (at.position - first_.position) / dt;
+  at.angular_velocity = LogSO3(first_from_current.rotation) / dt;
+  // The frames in between: the tracks' frames 1 .. size - 2.
+  std::vector<cv::Point3d> points;
+  for (const Eigen::Vector3d& x : motion.points) points.emplace_back(x.x(), x.y(), x.z());
+  for (size_t f = 1; f + 1 < tracks_.size(); ++f) {
+    std::vector<cv::Point2d> pixels;
+    for (int i : motion.inliers) pixels.emplace_back(tracks_[f][i]);
+    // Start from the pose interpolated between the first and the current camera.
+    const double share = static_cast<double>(f) / (tracks_.size() - 1);
+    const Rigid3d guess(Eigen::Quaterniond::Identity().slerp(share, first_from_current.rotation),
+                        share * first_from_current.translation);
+    const Rigid3d cam_from_first = guess.Inverse();
+    Eigen::Vector3d r = LogSO3(cam_from_first.rotation), t = cam_from_first.translation;  // OpenCV's rvec, tvec
+    cv::Mat rvec, tvec;
+    cv::eigen2cv(r, rvec);
+    cv::eigen2cv(t, tvec);
+    Rigid3d first_from_frame = guess;
+    if (cv::solvePnP(points, pixels, camera_.K(), cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE)) {
+      cv::cv2eigen(rvec, r);
+      cv::cv2eigen(tvec, t);
+      first_from_frame = Rigid3d(ExpSO3(r), t).Inverse();
+    }
+    start.revised.emplace_back(index_ + f, world_from_first * first_from_frame);
+  }
+  const Rigid3d current_from_first = first_from_current.Inverse();
+  for (size_t j = 0; j < motion.inliers.size(); ++j) {
+    const cv::Point2f& pixel = tracks_.back()[motion.inliers[j]];
+    start.corners.push_back({Eigen::Vector2d(pixel.x, pixel.y), 1 / (current_from_first * motion.points[j]).norm()});
+  }
+  PDVO_LOG(Debug) << "vo: two-view bootstrap after " << tracks_.size() - 1 << " frames, " << start.corners.size()
+                  << " triangulated corners, direction " << first_from_current.translation.normalized().transpose();
+  Stop();
+  return start;
+}
+
+}  // namespace pdvo::vo

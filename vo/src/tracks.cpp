@@ -1,0 +1,98 @@
+#include "pdvo/vo/tracks.h"
+
+#include <algorithm>
+
+#include "pdvo/common/options.h"
+#include "pdvo/vo/map.h"
+
+namespace pdvo::vo {
+
+bool FeatureOptions::Check() const {
+  PDVO_CHECK_OPTION(max_measurements >= 1 && min_features >= 1 && new_features >= 1 && min_distance >= 1);
+  PDVO_CHECK_OPTION(border >= 1 && max_misses >= 1 && min_rejections >= 1 && max_rejected_share >= 0);
+  return true;
+}
+
+bool Inside(const Eigen::Vector2d& p, const cv::Size& size, int border) {
+  return p.x() >= border && p.y() >= border && p.x() < size.width - border && p.y() < size.height - border;
+}
+
+cv::Mat InsideMask(const cv::Size& size, int border) {
+  cv::Mat mask(size, CV_8U, cv::Scalar(0));
+  mask(cv::Rect(border, border, size.width - 2 * border, size.height - 2 * border)).setTo(255);
+  return mask;
+}
+
+bool Tracks::Gone(const History& r, const FeatureOptions& o) {
+  return r.misses > o.max_misses || (r.rejected >= o.min_rejections && r.rejected > o.max_rejected_share * r.matched);
+}
+
+std::vector<Eigen::Vector2d> Tracks::Visible(const Filter& filter, const Camera& camera, int border) const {
+  const cv::Size size(camera.width, camera.height);
+  std::vector<Eigen::Vector2d> out;
+  Eigen::Vector2d pixel;
+  for (const auto& [id, p] : filter.points()) {
+    if (filter.PredictPoint(camera, id, &pixel, nullptr) && Inside(pixel, size, border)) out.push_back(pixel);
+  }
+  for (const auto& [id, t] : planes) {
+    for (const PlanePoint& m : t.members) {
+      if (filter.PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border)) {
+        out.push_back(pixel);
+      }
+    }
+  }
+  return out;
+}
+
+int Tracks::PlanePoints() const {
+  int n = 0;
+  for (const auto& [id, t] : planes) n += static_cast<int>(t.members.size());
+  return n;
+}
+
+void Tracks::RemovePoint(int id, Filter* filter, MapRecord* record) {
+  record->KeepPoint(*filter, id);
+  const int reference = filter->points().at(id).reference;
+  filter->RemovePoint(id);
+  points.erase(id);
+  if (!filter->references().count(reference)) keyframes.erase(reference);
+}
+
+void Tracks::RemovePlane(int id, Filter* filter, MapRecord* record) {
+  record->KeepPlane(*filter, id, planes.at(id));
+  const int reference = filter->planes().at(id).reference;
+  filter->RemovePlane(id);
+  planes.erase(id);
+  if (!filter->references().count(reference)) keyframes.erase(reference);
+}
+
+void Tracks::LeaveView(const Camera& camera, int border, Filter* filter, MapRecord* record) {
+  const cv::Size size(camera.width, camera.height);
+  Eigen::Vector2d pixel;
+  std::vector<int> gone;
+  for (const auto& [id, p] : filter->points()) {
+    if (!filter->PredictPoint(camera, id, &pixel, nullptr) || !Inside(pixel, size, border)) gone.push_back(id);
+  }
+  for (int id : gone) RemovePoint(id, filter, record);
+  gone.clear();
+  for (const auto& [id, t] : planes) {
+    const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
+      return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border);
+    });
+    if (!any) gone.push_back(id);
+  }
+  for (int id : gone) {
+    record->Record(id, planes.at(id));
+    RemovePlane(id, filter, record);
+  }
+}
+
+void Tracks::LeaveRejected(const FeatureOptions& options, Filter* filter, MapRecord* record) {
+  std::vector<int> bad;
+  for (const auto& [id, t] : points) {
+    if (Gone(t.history, options)) bad.push_back(id);
+  }
+  for (int id : bad) RemovePoint(id, filter, record);
+}
+
+}  // namespace pdvo::vo
