@@ -1,0 +1,89 @@
+#include "pdvo/infer/sphere.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+constexpr double kDegree = M_PI / 180;
+constexpr int kIterations = 50;
+constexpr double kConverged = 1e-9;  // change of the direction (radians) at which an iteration stops
+
+double Angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)); }
+
+void CheckInput(const std::vector<Eigen::Vector3d>& directions, const std::vector<double>& weights, double scale) {
+  PDVO_THROW_CHECK(directions.size() == weights.size() && scale > 0, InvalidArgument,
+                   "directions: " << directions.size() << " directions with " << weights.size()
+                                  << " weights, or a scale that is not positive");
+  for (size_t i = 0; i < weights.size(); ++i) {
+    PDVO_THROW_CHECK(weights[i] >= 0 && std::isfinite(weights[i]) && directions[i].allFinite(), InvalidArgument,
+                     "directions: a bad weight or direction at " << i);
+  }
+}
+
+}  // namespace
+
+Eigen::Vector3d RobustMeanDirection(const std::vector<Eigen::Vector3d>& d, const std::vector<double>& w,
+                                    double scale_deg) {
+  CheckInput(d, w, scale_deg);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < d.size(); ++i) sum += w[i] * d[i];
+  if (sum.norm() < 1e-12) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean = sum.normalized();
+  const double scale = scale_deg * kDegree;
+  for (int k = 0; k < kIterations; ++k) {
+    sum.setZero();
+    for (size_t i = 0; i < d.size(); ++i) {
+      const double r = Angle(mean, d[i]) / scale;
+      sum += w[i] / (1 + r * r) * d[i];
+    }
+    if (sum.norm() < 1e-12) break;
+    const Eigen::Vector3d next = sum.normalized();
+    const double change = Angle(next, mean);
+    mean = next;
+    if (change < kConverged) break;
+  }
+  return mean;
+}
+
+std::vector<DirectionMode> MeanShiftModes(const std::vector<Eigen::Vector3d>& d, const std::vector<double>& w,
+                                          double bandwidth_deg, double merge_deg) {
+  CheckInput(d, w, bandwidth_deg);
+  const double kappa = 1 / std::pow(bandwidth_deg * kDegree, 2);
+  std::vector<Eigen::Vector3d> modes;
+  for (size_t s = 0; s < d.size(); ++s) {
+    if (w[s] <= 0) continue;
+    Eigen::Vector3d m = d[s].normalized();
+    for (int k = 0; k < kIterations; ++k) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (size_t i = 0; i < d.size(); ++i) sum += w[i] * std::exp(kappa * (m.dot(d[i]) - 1)) * d[i];
+      if (sum.norm() < 1e-300) break;
+      const Eigen::Vector3d next = sum.normalized();
+      const double change = Angle(next, m);
+      m = next;
+      if (change < kConverged) break;
+    }
+    const bool known = std::any_of(modes.begin(), modes.end(),
+                                   [&](const Eigen::Vector3d& q) { return Angle(q, m) < merge_deg * kDegree; });
+    if (!known) modes.push_back(m);
+  }
+  std::vector<DirectionMode> out;
+  for (const Eigen::Vector3d& m : modes) out.push_back({m, 0});
+  for (size_t i = 0; i < d.size(); ++i) {
+    if (out.empty()) break;
+    size_t nearest = 0;
+    for (size_t k = 1; k < out.size(); ++k) {
+      if (out[k].direction.dot(d[i]) > out[nearest].direction.dot(d[i])) nearest = k;
+    }
+    out[nearest].support += w[i];
+  }
+  std::stable_sort(out.begin(), out.end(), [](const DirectionMode& a, const DirectionMode& b) {
+    return a.support > b.support;
+  });
+  return out;
+}
+
+}  // namespace pdvo
