@@ -24,6 +24,7 @@ constexpr Command kCommands[] = {
     {"synth", pdvo::apps::RunSynth, "render a synthetic urban street sequence with exact ground truth"},
     {"train", pdvo::apps::RunTrain, "train the plane recogniser on annotations into one model file"},
     {"evaluate", pdvo::apps::RunEvaluate, "region recognition accuracy and normal error of a model"},
+    {"detect", pdvo::apps::RunDetect, "find the planes in single images: windows, MRF segmentation, annotations"},
     {"vo", pdvo::apps::RunVo, "monocular visual odometry (EKF, inverse-depth points) over a sequence"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
 };

@@ -68,5 +68,6 @@ int RunSynth(int argc, char** argv);
 int RunTrain(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunVo(int argc, char** argv);
+int RunDetect(int argc, char** argv);
 
 }  // namespace pdvo::apps

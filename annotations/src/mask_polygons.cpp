@@ -77,6 +77,7 @@ void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& non
       shape.label = kPlaneLabel;
       shape.points = std::move(polygon);
       shape.normal = plane.normal;
+      shape.score = plane.score;
       a->shapes.push_back(std::move(shape));
       covered |= RasteriseShape(a->shapes.back(), *a, size);
     }

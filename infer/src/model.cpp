@@ -68,6 +68,14 @@ double RvmFunction::operator()(const Eigen::VectorXd& x) const {
   return sum;
 }
 
+Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
+  if (vectors.rows() == 0) return Eigen::VectorXd::Constant(rows.rows(), -bias);
+  Eigen::MatrixXd distance = -2.0 * rows * vectors.transpose();
+  distance.colwise() += rows.rowwise().squaredNorm();
+  distance.rowwise() += vectors.rowwise().squaredNorm().transpose();
+  return (-gamma * distance.cwiseMax(0.0)).array().exp().matrix() * weights - Eigen::VectorXd::Constant(rows.rows(), bias);
+}
+
 bool RecogniserOptions::Check() const {
   PDVO_CHECK_OPTION(working_width == 0 || working_width >= 32);
   PDVO_CHECK_OPTION(features.Check());

@@ -168,6 +168,29 @@ RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
   return p;
 }
 
+std::vector<RegionPrediction> Recogniser::PredictRows(const Eigen::MatrixXd& features) const {
+  PDVO_THROW_CHECK(features.cols() == model_.feature_mean.size() || features.rows() == 0, InvalidArgument,
+                   "recogniser: " << features.cols() << "-D features for a model of " << model_.feature_mean.size());
+  const Eigen::MatrixXd x = (features.rowwise() - model_.feature_mean.transpose()).array().rowwise() /
+                            model_.feature_scale.transpose().array();
+  Eigen::VectorXd probability = Eigen::VectorXd::Zero(x.rows());
+  for (const RvmFunction& f : model_.classifiers) {
+    probability += (1.0 + (-f.Evaluate(x)).array().exp()).inverse().matrix();
+  }
+  probability /= static_cast<double>(model_.classifiers.size());
+  const Eigen::VectorXd nx = model_.normal[0].Evaluate(x), ny = model_.normal[1].Evaluate(x);
+  const Eigen::VectorXd nz = model_.normal[2].Evaluate(x);
+  std::vector<RegionPrediction> out(static_cast<size_t>(x.rows()));
+  for (Eigen::Index k = 0; k < x.rows(); ++k) {
+    RegionPrediction& p = out[static_cast<size_t>(k)];
+    p.valid = true;
+    p.plane_probability = probability[k];
+    const Eigen::Vector3d n(nx[k], ny[k], nz[k]);
+    if (n.norm() > 1e-9) p.normal = n.normalized();
+  }
+  return out;
+}
+
 RegionPrediction Recogniser::Recognise(const ImageWords& words, const Region& region) const {
   const RecogniserOptions& o = model_.options;
   RegionWords r = CollectRegionWords(words, region, model_.gradient_words.size(), model_.colour_words.size());

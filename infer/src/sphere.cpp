@@ -10,7 +10,7 @@ namespace {
 
 constexpr double kDegree = M_PI / 180;
 constexpr int kIterations = 50;
-constexpr double kConverged = 1e-9;  // change of the direction (radians) at which an iteration stops
+constexpr double kConverged = 1e-7;  // change of the direction (radians) at which an iteration stops
 
 double Angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::acos(std::clamp(a.dot(b), -1.0, 1.0)); }
 
@@ -50,16 +50,23 @@ Eigen::Vector3d RobustMeanDirection(const std::vector<Eigen::Vector3d>& d, const
 }
 
 std::vector<DirectionMode> MeanShiftModes(const std::vector<Eigen::Vector3d>& d, const std::vector<double>& w,
-                                          double bandwidth_deg, double merge_deg) {
+                                          double bandwidth_deg, double merge_deg, int max_starts) {
   CheckInput(d, w, bandwidth_deg);
+  PDVO_THROW_CHECK(max_starts >= 1, InvalidArgument, "mean shift: max_starts must be positive");
   const double kappa = 1 / std::pow(bandwidth_deg * kDegree, 2);
+  // The kernel is cut off beyond three bandwidths (where it is below 1.2% of its peak).
+  const double cutoff = std::cos(std::min(M_PI, 3 * bandwidth_deg * kDegree));
   std::vector<Eigen::Vector3d> modes;
-  for (size_t s = 0; s < d.size(); ++s) {
+  const size_t step = std::max<size_t>(1, (d.size() + max_starts - 1) / max_starts);
+  for (size_t s = 0; s < d.size(); s += step) {
     if (w[s] <= 0) continue;
     Eigen::Vector3d m = d[s].normalized();
     for (int k = 0; k < kIterations; ++k) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (size_t i = 0; i < d.size(); ++i) sum += w[i] * std::exp(kappa * (m.dot(d[i]) - 1)) * d[i];
+      for (size_t i = 0; i < d.size(); ++i) {
+        const double c = m.dot(d[i]);
+        if (c > cutoff) sum += w[i] * std::exp(kappa * (c - 1)) * d[i];
+      }
       if (sum.norm() < 1e-300) break;
       const Eigen::Vector3d next = sum.normalized();
       const double change = Angle(next, m);

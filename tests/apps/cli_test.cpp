@@ -224,6 +224,47 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   for (const char* o : {"o1", "o2", "o3"}) EXPECT_FALSE(fs::exists(dir / o)) << o << ": no partial output";
 }
 
+// pdvo detect on a synthetic street: one valid annotation per image, with scored planes; the same run gives the
+// same bytes; bad input is one line naming the file, with no output folder left.
+TEST(Cli, DetectWritesAnnotationsAndRefusesBadInput) {
+  test::TempDir dir;
+  ASSERT_EQ(Pdvo("synth -o " + (dir / "s") + " -n 3 --seed 6 --set walk.fps=1 -v warning", dir).code, 0);
+  const std::string model = PDVO_SOURCE_DIR "/models/default/model.yml";
+  const CommandResult ok = Pdvo("detect -m " + model + " " + (dir / "s") + " -o " + (dir / "det") + " -v warning", dir);
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  int planes = 0;
+  for (const char* name : {"000000.json", "000001.json", "000002.json"}) {
+    const std::string path = dir / ("det/" + std::string(name));
+    const Annotation a = ReadAnnotation(path);
+    for (const ValidationIssue& issue : Validate(a)) EXPECT_FALSE(issue.is_error) << name << ": " << issue.message;
+    for (const AnnotationShape& shape : a.shapes) {
+      if (!shape.IsPlane()) continue;
+      ++planes;
+      ASSERT_TRUE(shape.score.has_value());
+      EXPECT_GE(*shape.score, 0.5);
+    }
+    EXPECT_TRUE(fs::exists(ResolveImagePath(a, path))) << name << ": the image path resolves";
+  }
+  EXPECT_GT(planes, 0);
+  EXPECT_TRUE(fs::exists(dir / "det/detector.yaml"));
+  ASSERT_EQ(Pdvo("detect -m " + model + " " + (dir / "s/rgb/000001.png") + " -c " + (dir / "s/camera.yaml") +
+                     " -o " + (dir / "one") + " -v warning",
+                 dir).code, 0);
+  EXPECT_EQ(ReadFile(dir / "one/000001.json"), ReadFile(dir / "det/000001.json"));
+
+  const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
+  expect_error("detect -v warning -m " + model + " " + (dir / "gone.png") + " -o " + (dir / "o1"), "gone.png");
+  fs::create_directories(dir / "empty");
+  expect_error("detect -v warning -m " + model + " " + (dir / "empty") + " -o " + (dir / "o2"), "empty");
+  expect_error("detect -v warning -m " + (dir / "s/camera.yaml") + " " + (dir / "s") + " -o " + (dir / "o3"),
+               "camera.yaml");
+  cv::imwrite(dir / "tiny.png", cv::Mat(20, 20, CV_8UC3, cv::Scalar(0, 0, 0)));
+  expect_error("detect -v warning -m " + model + " " + (dir / "tiny.png") + " -o " + (dir / "o4") +
+                   " --set window_sizes=400",
+               "smaller than the smallest window");
+  for (const char* o : {"o1", "o2", "o3", "o4"}) EXPECT_FALSE(fs::exists(dir / o)) << o << ": no partial output";
+}
+
 }  // namespace
 }  // namespace pdvo
 

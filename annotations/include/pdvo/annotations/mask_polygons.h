@@ -3,6 +3,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "pdvo/annotations/annotation.h"
@@ -20,6 +21,7 @@ std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask, in
 struct PlaneMask {
   cv::Mat mask;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  std::optional<double> score;  // a detector's confidence, given to the plane's shapes
 };
 
 struct MaskPolygonOptions {

@@ -29,6 +29,8 @@ struct RvmFunction {
   Eigen::MatrixXd vectors;  // relevance vectors, one per row
 
   double operator()(const Eigen::VectorXd& x) const;
+  // The same for each row of `rows` at once (squared distances by one matrix product; equal to rounding).
+  Eigen::VectorXd Evaluate(const Eigen::MatrixXd& rows) const;
   int size() const { return static_cast<int>(weights.size()); }
 };
 

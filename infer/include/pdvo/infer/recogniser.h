@@ -101,6 +101,8 @@ class Recogniser {
   // (FuseNormal in vanishing.h) and without turning the normal to face the camera, which need the image. The
   // plane probability is the mean of the classifiers' logistic probabilities.
   RegionPrediction Predict(const Eigen::VectorXd& feature) const;
+  // Predict for each row of `features` (one region's feature per row), with the RVMs evaluated as matrix products.
+  std::vector<RegionPrediction> PredictRows(const Eigen::MatrixXd& features) const;
 
  private:
   PlaneModel model_;

@@ -18,9 +18,12 @@ struct DirectionMode {
   Eigen::Vector3d direction;  // unit
   double support = 0;         // the weight of the directions nearest to it
 };
-// The modes of the weighted directions: mean shift with the kernel exp(cos(angle) - 1) / bandwidth^2, started
-// from every direction, modes within `merge_deg` merged; ordered by support, largest first. Deterministic.
+// The modes of the weighted directions: mean shift with the kernel exp((cos(angle) - 1) / bandwidth^2) (cut off
+// beyond three bandwidths), started
+// from every direction (or, of more than `max_starts`, from as many spread evenly through the list), modes
+// within `merge_deg` merged; ordered by support, largest first. Deterministic.
 std::vector<DirectionMode> MeanShiftModes(const std::vector<Eigen::Vector3d>& directions,
-                                          const std::vector<double>& weights, double bandwidth_deg, double merge_deg);
+                                          const std::vector<double>& weights, double bandwidth_deg, double merge_deg,
+                                          int max_starts = 32);
 
 }  // namespace pdvo

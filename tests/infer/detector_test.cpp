@@ -1,0 +1,127 @@
+// The plane detector: pooling on hand-made windows; an end-to-end detection on a rendered street whose planes are
+// known (its largest planes found, with their orientation); the same image gives the same annotation bytes, from
+// one thread or two at once; images too small or empty are refused; the shipped options file equals the defaults.
+#include "pdvo/infer/detector.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "pdvo/annotations/raster.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/common/options.h"
+#include "pdvo/sim/renderer.h"
+#include "pdvo/sim/synth.h"
+
+namespace pdvo {
+namespace {
+
+TEST(Detector, PoolsTheWindowsThatHoldAPoint) {
+  const std::vector<cv::Point2f> points = {{10, 10}, {50, 10}, {200, 200}};
+  const Eigen::Vector3d a(0, 0, -1), b = Eigen::Vector3d(1, 0, -1).normalized(), c(0, -1, 0);
+  // Point 0 lies in windows 0-2, point 1 in windows 1-3 only, point 2 in none.
+  const std::vector<DetectedWindow> windows = {{cv::Rect(0, 0, 40, 40), 0.9, a},
+                                               {cv::Rect(0, 0, 64, 64), 0.8, a},
+                                               {cv::Rect(8, 0, 64, 32), 0.2, b},
+                                               {cv::Rect(40, 0, 32, 32), 0.6, c}};
+  const PointPooling p = PoolWindows(points, windows, 15);
+  EXPECT_DOUBLE_EQ(p.planarity[0], 0.8);         // the median of 0.9, 0.8, 0.2
+  EXPECT_DOUBLE_EQ(p.planarity[1], 0.6);         // of 0.8, 0.2, 0.6
+  EXPECT_DOUBLE_EQ(p.planarity[2], 0.5);         // no window: undecided
+  EXPECT_LT((p.normals[0] - a).norm(), 0.05);    // the light, far normal b hardly moves the robust mean
+  EXPECT_EQ(p.normals[2], Eigen::Vector3d::Zero());
+}
+
+struct StreetFrame {
+  cv::Mat image;
+  Annotation truth;
+  Camera camera;
+};
+
+StreetFrame RenderStreet(uint64_t seed, int frame) {
+  sim::SynthOptions options;
+  options.walk.fps = 1;
+  const sim::Street street = sim::GenerateStreet(options.street, 60, seed);
+  const Trajectory walk = sim::WalkStreet(street, options.walk, frame + 1, seed);
+  StreetFrame s;
+  s.camera = options.MakeCamera();
+  const sim::Renderer renderer(street, s.camera, options.render, seed);
+  sim::RenderedFrame rendered;
+  renderer.Render({walk[frame].world_from_cam}, walk[frame].timestamp, frame, &rendered);
+  s.image = rendered.image;
+  s.truth = sim::AnnotateFrame(street, rendered, walk[frame].world_from_cam, s.camera, "frame.png");
+  return s;
+}
+
+const Detector& DefaultDetector() {
+  static const Detector detector(PlaneModel::Read(PDVO_SOURCE_DIR "/models/default/model.yml"), DetectorOptions{});
+  return detector;
+}
+
+double Iou(const cv::Mat& a, const cv::Mat& b) {
+  const double inter = cv::countNonZero(a & b), uni = cv::countNonZero(a | b);
+  return uni > 0 ? inter / uni : 0.0;
+}
+
+// On a street the model never saw (seed 951), at least half the true planes covering 10% of the frame or more are
+// found: a detected plane overlaps each with IoU >= 0.4 and a normal within 30 degrees (measured: 5 of 7).
+TEST(Detector, FindsTheLargePlanesOfARenderedStreet) {
+  int large = 0, found = 0;
+  for (const int frame : {3, 9, 14}) {
+    const StreetFrame s = RenderStreet(951, frame);
+    const Detections d = DefaultDetector().Detect(s.image, s.camera);
+    const Annotation detected = d.ToAnnotation("frame.png", s.image.cols, s.image.rows, s.camera);
+    for (const ValidationIssue& issue : Validate(detected)) EXPECT_FALSE(issue.is_error) << issue.message;
+    for (const AnnotationShape& truth : s.truth.shapes) {
+      if (!truth.IsPlane()) continue;
+      const cv::Mat t = RasteriseShape(truth, s.truth);
+      if (cv::countNonZero(t) < 0.1 * s.image.total()) continue;
+      ++large;
+      for (const AnnotationShape& shape : detected.shapes) {
+        if (!shape.IsPlane()) continue;
+        const double angle = std::acos(std::clamp(shape.normal->dot(*truth.normal), -1.0, 1.0)) * 180 / M_PI;
+        if (Iou(RasteriseShape(shape, detected), t) >= 0.4 && angle <= 30) {
+          ++found;
+          break;
+        }
+      }
+    }
+  }
+  ASSERT_GT(large, 3);
+  EXPECT_GE(found, large / 2) << found << " of " << large << " large planes found";
+  RecordProperty("large_planes_found", std::to_string(found) + " of " + std::to_string(large));
+}
+
+TEST(Detector, TheSameImageGivesTheSameBytesFromAnyThread) {
+  const StreetFrame s = RenderStreet(952, 5);
+  const Detector& detector = DefaultDetector();
+  const std::string once = AnnotationToJson(detector.Detect(s.image).ToAnnotation("f.png", 320, 240));
+  EXPECT_EQ(AnnotationToJson(detector.Detect(s.image).ToAnnotation("f.png", 320, 240)), once);
+  std::string a, b;
+  std::thread first([&] { a = AnnotationToJson(detector.Detect(s.image).ToAnnotation("f.png", 320, 240)); });
+  std::thread second([&] { b = AnnotationToJson(detector.Detect(s.image).ToAnnotation("f.png", 320, 240)); });
+  first.join();
+  second.join();
+  EXPECT_EQ(a, once);
+  EXPECT_EQ(b, once);
+}
+
+TEST(Detector, RefusesImagesItCannotDetectIn) {
+  const Detector& detector = DefaultDetector();
+  EXPECT_THROW(detector.Detect(cv::Mat()), InvalidArgument);
+  EXPECT_THROW(detector.Detect(cv::Mat(240, 320, CV_32FC3)), InvalidArgument);
+  DetectorOptions large;
+  large.window_sizes = {400};  // larger than a 320 x 240 image
+  const Detector too_large(detector.recogniser().model(), large);
+  EXPECT_THROW(too_large.Detect(cv::Mat(240, 320, CV_8UC3, cv::Scalar(90, 90, 90))), InvalidArgument);
+  DetectorOptions bad;
+  bad.overlap = 1;
+  EXPECT_THROW(Detector(detector.recogniser().model(), bad), InvalidArgument);
+}
+
+TEST(Detector, TheShippedOptionsAreTheDefaults) {
+  EXPECT_EQ(LoadOptions<DetectorOptions>(PDVO_SOURCE_DIR "/infer/config/detector.yaml", "detector"), DetectorOptions{});
+}
+
+}  // namespace
+}  // namespace pdvo
