@@ -33,8 +33,11 @@ int RunDetect(int argc, char** argv) {
   std::vector<std::string> overrides;
   size_t max_frames = 0;
   app.add_option("--model,-m", model_path, "Plane model file")->capture_default_str();
-  app.add_option("input", input, "An image, an image folder, or a sequence (video, TUM, KITTI, pdvo synth)")
-      ->required();
+  std::string annotations_dir;
+  app.add_option("input", input, "An image, an image folder, or a sequence (video, TUM, KITTI, pdvo synth)");
+  app.add_option("--annotations,-a", annotations_dir,
+                 "Instead of an input: the images that these annotations are of, each with its annotation's "
+                 "camera; detections are named as the annotations (for pdvo evaluate-detection)");
   app.add_option("--out,-o", out_dir, "Output folder")->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML of the images (default: the sequence's own, if any)");
   app.add_option("--max-frames", max_frames, "Stop after this many images (0: all)");
@@ -44,6 +47,10 @@ int RunDetect(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
+  if (input.empty() == annotations_dir.empty()) {
+    std::cerr << "pdvo detect: error: give an input or --annotations, one of them (see --help)\n";
+    return 1;
+  }
   const DetectorOptions options = LoadToolOptions<DetectorOptions>(config_path, "detector", overrides);
   const Detector detector(PlaneModel::Read(model_path), options);
   // The images: one file, or the frames of a sequence.
@@ -52,7 +59,11 @@ int RunDetect(int argc, char** argv) {
   std::optional<Camera> camera;
   if (!camera_path.empty()) camera = Camera::Read(camera_path);
   size_t total = 1;
-  if (IsImageFile(input)) {
+  std::vector<std::string> annotated;
+  if (!annotations_dir.empty()) {
+    annotated = ListAnnotationFiles({annotations_dir});
+    total = annotated.size();
+  } else if (IsImageFile(input)) {
     single.emplace_back(input, ReadImage(input, cv::IMREAD_COLOR));
   } else {
     sequence = OpenSequence(input);
@@ -70,7 +81,7 @@ int RunDetect(int argc, char** argv) {
   size_t done = 0, planes = 0;
   double milliseconds = 0;
   const std::filesystem::path final_dir = std::filesystem::absolute(out_dir);
-  auto detect = [&](const std::string& image_path, const cv::Mat& image) {
+  auto detect = [&](const std::string& image_path, const cv::Mat& image, const std::string& name) {
     PDVO_THROW_CHECK(!camera || (image.cols == camera->width && image.rows == camera->height), FormatError,
                      image_path << ": image is " << image.cols << "x" << image.rows << ", the camera says "
                                 << camera->width << "x" << camera->height);
@@ -78,18 +89,30 @@ int RunDetect(int argc, char** argv) {
     const std::string relative =
         std::filesystem::relative(std::filesystem::absolute(image_path), final_dir).generic_string();
     const Annotation a = d.ToAnnotation(relative, image.cols, image.rows, camera);
-    const std::string name = std::filesystem::path(image_path).stem().string() + ".json";
     WriteAnnotation(out.path(name), a);
     for (const AnnotationShape& s : a.shapes) planes += s.IsPlane();
     milliseconds += d.times.total;
     ++done;
     progress.Step();
   };
-  for (const auto& [path, image] : single) detect(path, image);
+  auto json_name = [](const std::string& image_path) {
+    return std::filesystem::path(image_path).stem().string() + ".json";
+  };
+  for (const auto& [path, image] : single) detect(path, image, json_name(path));
   Frame frame;
   while (sequence && done < total && sequence->Next(&frame)) {
     PDVO_THROW_CHECK(!frame.image_path.empty(), InvalidArgument, input << ": the detector needs image files, not a video");
-    detect(frame.image_path, frame.image);
+    detect(frame.image_path, frame.image, json_name(frame.image_path));
+  }
+  for (size_t k = 0; k < annotated.size() && done < total; ++k) {
+    const Annotation reference = ReadAnnotation(annotated[k]);
+    const std::string image_path = ResolveImagePath(reference, annotated[k]);
+    const cv::Mat image = ReadImage(image_path, cv::IMREAD_COLOR);
+    PDVO_THROW_CHECK(image.cols == reference.image_width && image.rows == reference.image_height, FormatError,
+                     image_path << ": image is " << image.cols << "x" << image.rows << ", its annotation says "
+                                << reference.image_width << "x" << reference.image_height);
+    camera = reference.camera;
+    detect(image_path, image, std::filesystem::path(annotated[k]).filename().string());
   }
   progress.Finish();
   out.Commit();

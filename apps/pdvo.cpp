@@ -1,5 +1,6 @@
 // The `pdvo` command: one binary, one subcommand per job. main() turns every error into one line on stderr
 // and an exit code: 1 for a usage error, 2 for a failure while running.
+#include <algorithm>
 #include <cstring>
 #include <iostream>
 #include <opencv2/core.hpp>
@@ -25,6 +26,7 @@ constexpr Command kCommands[] = {
     {"train", pdvo::apps::RunTrain, "train the plane recogniser on annotations into one model file"},
     {"evaluate", pdvo::apps::RunEvaluate, "region recognition accuracy and normal error of a model"},
     {"detect", pdvo::apps::RunDetect, "find the planes in single images: windows, MRF segmentation, annotations"},
+    {"evaluate-detection", pdvo::apps::RunEvaluateDetection, "score detections against reference annotations"},
     {"vo", pdvo::apps::RunVo, "monocular visual odometry (EKF, inverse-depth points) over a sequence"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
 };
@@ -34,8 +36,10 @@ void PrintUsage(std::ostream& out) {
       << "): planes recognised in single images as priors for monocular visual odometry\n\n"
       << "Usage: pdvo <command> [options]   (pdvo <command> --help for more)\n\n"
       << "Commands:\n";
+  size_t width = 0;
+  for (const Command& c : kCommands) width = std::max(width, std::strlen(c.name));
   for (const Command& c : kCommands) {
-    out << "  " << c.name << std::string(16 - std::strlen(c.name), ' ') << c.summary << "\n";
+    out << "  " << c.name << std::string(width + 2 - std::strlen(c.name), ' ') << c.summary << "\n";
   }
 }
 

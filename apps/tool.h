@@ -69,5 +69,6 @@ int RunTrain(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunVo(int argc, char** argv);
 int RunDetect(int argc, char** argv);
+int RunEvaluateDetection(int argc, char** argv);
 
 }  // namespace pdvo::apps

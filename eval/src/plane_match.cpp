@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "compare.h"
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/eval/recognition.h"
@@ -11,12 +12,7 @@
 namespace pdvo {
 namespace {
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using detail::Median;
 
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -37,14 +33,7 @@ double Mean(const std::vector<double>& v) {
 
 PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& estimate,
                               const PlaneMatchOptions& options) {
-  PDVO_THROW_CHECK(reference.image_width == estimate.image_width && reference.image_height == estimate.image_height,
-                   InvalidArgument,
-                   "compare: reference is " << reference.image_width << "x" << reference.image_height
-                                            << " but the estimate is " << estimate.image_width << "x"
-                                            << estimate.image_height);
-  const double scale = std::min(1.0, static_cast<double>(options.max_width) / reference.image_width);
-  const cv::Size size(static_cast<int>(std::lround(reference.image_width * scale)),
-                      static_cast<int>(std::lround(reference.image_height * scale)));
+  const cv::Size size = detail::ComparisonSize(reference, estimate, options.max_width, "compare");
   auto plane_masks = [&](const Annotation& a, std::vector<int>* index) {
     std::vector<cv::Mat> masks;
     for (size_t i = 0; i < a.shapes.size(); ++i) {
@@ -163,4 +152,24 @@ double PlanePurity::Share(int min_points, long* points) const {
   return all > 0 ? static_cast<double>(on_main) / all : 0.0;
 }
 
+namespace detail {
+
+cv::Size ComparisonSize(const Annotation& reference, const Annotation& estimate, int max_width, const char* what) {
+  PDVO_THROW_CHECK(reference.image_width == estimate.image_width && reference.image_height == estimate.image_height,
+                   InvalidArgument,
+                   what << ": the reference is " << reference.image_width << "x" << reference.image_height
+                        << " but the estimate is " << estimate.image_width << "x" << estimate.image_height);
+  const double scale = std::min(1.0, static_cast<double>(max_width) / reference.image_width);
+  return {static_cast<int>(std::lround(reference.image_width * scale)),
+          static_cast<int>(std::lround(reference.image_height * scale))};
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace detail
 }  // namespace pdvo

@@ -145,7 +145,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
-  PDVO_CHECK_OPTION(cell_radius > 0);
+  PDVO_CHECK_OPTION(cell_radius > 0 && min_edge_weight >= 0 && min_edge_weight <= 1);
   return true;
 }
 
@@ -223,7 +223,12 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     const double w = o.plane_smoothness * weight[e];
     planes.AddPairwise(edges[e].first, edges[e].second, 0, w, w, 0);
   }
-  d.plane_label = planes.Minimise();
+  if (o.mrf_planes) {
+    d.plane_label = planes.Minimise();
+  } else {
+    d.plane_label.resize(n);
+    for (int i = 0; i < n; ++i) d.plane_label[i] = d.planarity[i] > 0.5;
+  }
 
   // MRF 2 over the planar points that have a normal.
   std::vector<int> planar;
@@ -259,7 +264,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
       const int a = node[edges[e].first], b = node[edges[e].second];
       if (a >= 0 && b >= 0) potts.push_back({a, b, o.orientation_smoothness * weight[e]});
     }
-    const std::vector<int> labels = AlphaExpansion(cost, potts, initial);
+    const std::vector<int> labels = o.mrf_orientations ? AlphaExpansion(cost, potts, initial) : initial;
     for (size_t p = 0; p < planar.size(); ++p) d.orientation[planar[p]] = labels[p];
   }
   d.times.segmentation = Ms(t);
@@ -300,7 +305,12 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     }
     return mask;
   };
-  for (const std::vector<int>& members : Components(n, edges, d.orientation)) {
+  // Segments follow only the edges of some weight: a colour boundary splits points of one orientation.
+  std::vector<std::pair<int, int>> strong;
+  for (size_t e = 0; e < edges.size(); ++e) {
+    if (weight[e] >= o.min_edge_weight) strong.push_back(edges[e]);
+  }
+  for (const std::vector<int>& members : Components(n, strong, d.orientation)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
     DetectedSegment s;
     s.planar = true;
@@ -308,13 +318,24 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     s.mask = area_of(members);
     const cv::Rect box = cv::boundingRect(s.mask);
     if (box.area() == 0) continue;
-    const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
-    if (!p.valid || p.plane_probability < o.min_plane_probability) continue;
-    s.normal = p.normal;
-    s.score = p.plane_probability;
+    if (o.rerecognise) {
+      const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
+      if (!p.valid || p.plane_probability < o.min_plane_probability) continue;
+      s.normal = p.normal;
+      s.score = p.plane_probability;
+    } else {
+      std::vector<Eigen::Vector3d> member_normals;
+      std::vector<double> member_weights;
+      for (const int i : members) {
+        member_normals.push_back(d.normals[i]);
+        member_weights.push_back(d.planarity[i]);
+        s.score += d.planarity[i] / static_cast<double>(members.size());
+      }
+      s.normal = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    }
     d.segments.push_back(std::move(s));
   }
-  for (const std::vector<int>& members : Components(n, edges, non_planar)) {
+  for (const std::vector<int>& members : Components(n, strong, non_planar)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
     DetectedSegment s;
     s.points = members;

@@ -78,7 +78,8 @@ TEST(Cli, UsageAndHelp) {
   EXPECT_EQ(help.code, 0);
   EXPECT_NE(help.out.find("annotate-depth"), std::string::npos);
   EXPECT_EQ(Pdvo("frobnicate", dir).code, 1);
-  for (const char* command : {"show", "validate", "annotate-depth", "compare", "ate"}) {
+  for (const char* command :
+       {"show", "validate", "annotate-depth", "compare", "ate", "detect", "evaluate-detection"}) {
     const CommandResult r = Pdvo(std::string(command) + " --help", dir);
     EXPECT_EQ(r.code, 0) << command;
     EXPECT_NE(r.out.find("--verbosity"), std::string::npos) << command;

@@ -1,0 +1,191 @@
+#include "pdvo/eval/detection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "pdvo/annotations/raster.h"
+#include "compare.h"
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+double Ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
+double F1(double p, double r) { return p + r > 0 ? 2 * p * r / (p + r) : 0.0; }
+using detail::Median;
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
+}
+// n choose 2.
+double Pairs(double n) { return 0.5 * n * (n - 1); }
+
+}  // namespace
+
+DetectionScore ScoreDetection(const Annotation& reference, const Annotation& detection,
+                              const DetectionScoreOptions& options) {
+  const cv::Size size = detail::ComparisonSize(reference, detection, options.max_width, "detection score");
+  const AnnotationMasks ref = Rasterise(reference, size), det = Rasterise(detection, size);
+  DetectionScore s;
+  // Per reference plane and per detected plane: pixel counts and their overlaps.
+  std::map<int, long> ref_area, det_area;
+  std::map<std::pair<int, int>, long> overlap;  // (reference shape, detected shape or -1) on reference planes
+  for (int y = 0; y < size.height; ++y) {
+    const uchar* rl = ref.label.ptr<uchar>(y);
+    const uchar* dl = det.label.ptr<uchar>(y);
+    const int* rs = ref.shape_index.ptr<int>(y);
+    const int* ds = det.shape_index.ptr<int>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const bool det_plane = dl[x] == kMaskPlane, det_nonplane = dl[x] == kMaskNonPlane;
+      if (det_plane) ++det_area[ds[x]];
+      if (rl[x] == kMaskPlane) {
+        (det_plane ? s.plane_as_plane : det_nonplane ? s.plane_as_nonplane : s.plane_as_none) += 1;
+        ++ref_area[rs[x]];
+        ++overlap[{rs[x], det_plane ? ds[x] : -1}];
+      } else if (rl[x] == kMaskNonPlane) {
+        (det_plane ? s.nonplane_as_plane : det_nonplane ? s.nonplane_as_nonplane : s.nonplane_as_none) += 1;
+      }
+    }
+  }
+  // Plane recall: IoU of each reference plane with each detected plane (over all pixels, not only annotated).
+  const double image = static_cast<double>(size.area());
+  std::vector<bool> det_matched(detection.shapes.size(), false);
+  for (const auto& [r, area] : ref_area) {
+    const AnnotationShape& rs = reference.shapes[r];
+    const bool counted = area >= options.min_plane_share * image;
+    s.reference_planes += counted;
+    // Its match: the detected plane of highest IoU, if at least match_iou.
+    int best = -1;
+    double best_iou = options.match_iou;
+    for (const auto& [key, inter] : overlap) {
+      if (key.first != r || key.second < 0) continue;
+      const int d = key.second;
+      const double iou = inter / static_cast<double>(area + det_area[d] - inter);
+      if (iou >= best_iou) best = d, best_iou = iou;
+    }
+    if (best < 0) continue;
+    det_matched[best] = true;
+    const AnnotationShape& ds = detection.shapes[best];
+    if (!rs.normal || !ds.normal) continue;
+    const double angle = AngleDeg(*rs.normal, *ds.normal);
+    s.normal_errors_deg.push_back(angle);
+    if (counted) {
+      s.matched_10 += angle <= 10;
+      s.matched_30 += angle <= 30;
+    }
+  }
+  for (const auto& [d, area] : det_area) s.spurious_planes += !det_matched[d];
+  // Segmentation over the reference plane pixels, from the contingency table `overlap`.
+  double n = 0;
+  std::map<int, double> a, b;
+  for (const auto& [key, count] : overlap) {
+    n += count;
+    a[key.first] += count;
+    b[key.second] += count;
+  }
+  s.segmentation_pixels = static_cast<long>(n);
+  if (n > 1) {
+    double same = 0, sa = 0, sb = 0, information = 0, ha = 0, hb = 0;
+    for (const auto& [key, count] : overlap) {
+      same += Pairs(count);
+      information += count / n * std::log2(count * n / (a[key.first] * b[key.second]));
+    }
+    for (const auto& [k, v] : a) sa += Pairs(v), ha -= v / n * std::log2(v / n);
+    for (const auto& [k, v] : b) sb += Pairs(v), hb -= v / n * std::log2(v / n);
+    s.rand_index = 1 + (2 * same - sa - sb) / Pairs(n);
+    s.variation_of_information = std::max(0.0, ha + hb - 2 * information);
+    double covering = 0;
+    for (const auto& [r, area] : a) {
+      double best = 0;
+      for (const auto& [key, inter] : overlap) {
+        if (key.first != r || key.second < 0) continue;
+        best = std::max(best, static_cast<double>(inter) / static_cast<double>(ref_area[r] + det_area[key.second] - inter));
+      }
+      covering += area * best;
+    }
+    s.covering = covering / n;
+  }
+  return s;
+}
+
+DetectionSummary Summarise(const std::vector<DetectionScore>& scores) {
+  DetectionSummary m;
+  double pp = 0, pn = 0, p0 = 0, np = 0, nn = 0, n0 = 0, matched_10 = 0, matched_30 = 0;
+  std::vector<double> errors;
+  int segmented = 0;
+  for (const DetectionScore& s : scores) {
+    ++m.images;
+    pp += s.plane_as_plane, pn += s.plane_as_nonplane, p0 += s.plane_as_none;
+    np += s.nonplane_as_plane, nn += s.nonplane_as_nonplane, n0 += s.nonplane_as_none;
+    m.reference_planes += s.reference_planes;
+    matched_10 += s.matched_10, matched_30 += s.matched_30;
+    errors.insert(errors.end(), s.normal_errors_deg.begin(), s.normal_errors_deg.end());
+    m.spurious_planes += s.spurious_planes;
+    if (s.segmentation_pixels > 1) {
+      ++segmented;
+      m.rand_index += s.rand_index;
+      m.variation_of_information += s.variation_of_information;
+      m.covering += s.covering;
+    }
+  }
+  m.plane_precision = Ratio(pp, pp + np);
+  m.plane_recall = Ratio(pp, pp + pn + p0);
+  m.plane_f1 = F1(m.plane_precision, m.plane_recall);
+  m.nonplane_precision = Ratio(nn, nn + pn);
+  m.nonplane_recall = Ratio(nn, nn + np + n0);
+  m.nonplane_f1 = F1(m.nonplane_precision, m.nonplane_recall);
+  m.false_plane_area = Ratio(np, pp + np);
+  m.plane_recall_10 = Ratio(matched_10, m.reference_planes);
+  m.plane_recall_30 = Ratio(matched_30, m.reference_planes);
+  for (const double e : errors) m.mean_normal_error_deg += e / static_cast<double>(errors.size());
+  m.median_normal_error_deg = Median(errors);
+  if (segmented > 0) {
+    m.rand_index /= segmented;
+    m.variation_of_information /= segmented;
+    m.covering /= segmented;
+  }
+  return m;
+}
+
+nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const DetectionScoreOptions& options) {
+  const DetectionSummary m = Summarise(scores);
+  nlohmann::json images = nlohmann::json::array();
+  for (const DetectionScore& s : scores) {
+    images.push_back({{"name", s.name},
+                      {"pixels", {{"plane_as_plane", s.plane_as_plane}, {"plane_as_nonplane", s.plane_as_nonplane},
+                                  {"plane_as_none", s.plane_as_none}, {"nonplane_as_plane", s.nonplane_as_plane},
+                                  {"nonplane_as_nonplane", s.nonplane_as_nonplane},
+                                  {"nonplane_as_none", s.nonplane_as_none}}},
+                      {"reference_planes", s.reference_planes},
+                      {"matched_10", s.matched_10},
+                      {"matched_30", s.matched_30},
+                      {"normal_errors_deg", s.normal_errors_deg},
+                      {"spurious_planes", s.spurious_planes},
+                      {"rand_index", s.rand_index},
+                      {"variation_of_information", s.variation_of_information},
+                      {"covering", s.covering}});
+  }
+  const nlohmann::json summary = {{"images", m.images},
+                                  {"plane_precision", m.plane_precision},
+                                  {"plane_recall", m.plane_recall},
+                                  {"plane_f1", m.plane_f1},
+                                  {"nonplane_precision", m.nonplane_precision},
+                                  {"nonplane_recall", m.nonplane_recall},
+                                  {"nonplane_f1", m.nonplane_f1},
+                                  {"false_plane_area", m.false_plane_area},
+                                  {"reference_planes", m.reference_planes},
+                                  {"plane_recall_10", m.plane_recall_10},
+                                  {"plane_recall_30", m.plane_recall_30},
+                                  {"mean_normal_error_deg", m.mean_normal_error_deg},
+                                  {"median_normal_error_deg", m.median_normal_error_deg},
+                                  {"spurious_planes", m.spurious_planes},
+                                  {"rand_index", m.rand_index},
+                                  {"variation_of_information_bits", m.variation_of_information},
+                                  {"covering", m.covering}};
+  const std::string how = "pixels scored where the reference annotates; planes matched by IoU >= " +
+                          std::to_string(options.match_iou) + "; plane recall over reference planes of at least " +
+                          std::to_string(options.min_plane_share) + " of the image";
+  return {{"how", how}, {"summary", summary}, {"images", images}};
+}
+
+}  // namespace pdvo

@@ -1,0 +1,80 @@
+// Detection scores on hand-made annotations with known answers: a perfect detection; one plane over the whole
+// image with a turned normal (half its area false, matched within 30 degrees but not 10); a plane detected as two
+// halves (Rand index about one half, one bit of variation of information, covering one half).
+#include "pdvo/eval/detection.h"
+
+#include <gtest/gtest.h>
+
+#include "pdvo/common/errors.h"
+
+namespace pdvo {
+namespace {
+
+AnnotationShape Rect(const char* label, double x0, double y0, double x1, double y1,
+                     std::optional<Eigen::Vector3d> normal = std::nullopt) {
+  AnnotationShape s;
+  s.label = label;
+  s.points = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  s.normal = normal;
+  return s;
+}
+
+Annotation Image(std::vector<AnnotationShape> shapes) {
+  Annotation a;
+  a.image_path = "x.png";
+  a.image_width = 100;
+  a.image_height = 80;
+  a.shapes = std::move(shapes);
+  return a;
+}
+
+const Eigen::Vector3d kFacing(0, 0, -1);
+
+Annotation Reference() {
+  return Image({Rect(kPlaneLabel, -0.5, -0.5, 49.5, 79.5, kFacing), Rect(kNonPlaneLabel, 49.5, -0.5, 99.5, 79.5)});
+}
+
+TEST(DetectionScore, APerfectDetection) {
+  const DetectionSummary m = Summarise({ScoreDetection(Reference(), Reference())});
+  EXPECT_DOUBLE_EQ(m.plane_f1, 1);
+  EXPECT_DOUBLE_EQ(m.nonplane_f1, 1);
+  EXPECT_DOUBLE_EQ(m.false_plane_area, 0);
+  EXPECT_EQ(m.reference_planes, 1);
+  EXPECT_DOUBLE_EQ(m.plane_recall_10, 1);
+  EXPECT_NEAR(m.median_normal_error_deg, 0, 1e-6);
+  EXPECT_EQ(m.spurious_planes, 0);
+  EXPECT_DOUBLE_EQ(m.rand_index, 1);
+  EXPECT_NEAR(m.variation_of_information, 0, 1e-12);
+  EXPECT_DOUBLE_EQ(m.covering, 1);
+}
+
+TEST(DetectionScore, OnePlaneOverEverything) {
+  const Eigen::Vector3d turned(std::sin(20 * M_PI / 180), 0, -std::cos(20 * M_PI / 180));
+  const DetectionScore s = ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 99.5, 79.5, turned)}));
+  const DetectionSummary m = Summarise({s});
+  EXPECT_NEAR(m.plane_precision, 0.5, 0.02);
+  EXPECT_DOUBLE_EQ(m.plane_recall, 1);
+  EXPECT_NEAR(m.false_plane_area, 0.5, 0.02);
+  EXPECT_DOUBLE_EQ(m.nonplane_recall, 0);
+  EXPECT_DOUBLE_EQ(m.plane_recall_10, 0);
+  EXPECT_DOUBLE_EQ(m.plane_recall_30, 1);  // IoU 0.5 with the reference plane
+  EXPECT_NEAR(m.median_normal_error_deg, 20, 1e-6);
+}
+
+TEST(DetectionScore, APlaneInTwoHalves) {
+  const DetectionScore s = ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 49.5, 39.5, kFacing),
+                                                              Rect(kPlaneLabel, -0.5, 39.5, 49.5, 79.5, kFacing),
+                                                              Rect(kNonPlaneLabel, 49.5, -0.5, 99.5, 79.5)}));
+  EXPECT_DOUBLE_EQ(Summarise({s}).plane_f1, 1);
+  EXPECT_EQ(s.matched_10, 1);       // each half has IoU 0.5: the first is the match
+  EXPECT_EQ(s.spurious_planes, 1);  // and the other half spurious
+  EXPECT_NEAR(s.rand_index, 0.5, 0.01);
+  EXPECT_NEAR(s.variation_of_information, 1, 0.01);
+  EXPECT_NEAR(s.covering, 0.5, 0.01);
+  Annotation other = Reference();
+  other.image_width = 50;
+  EXPECT_THROW(ScoreDetection(Reference(), other), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pdvo
