@@ -145,7 +145,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
-  PDVO_CHECK_OPTION(cell_radius > 0 && min_edge_weight >= 0 && min_edge_weight <= 1);
+  PDVO_CHECK_OPTION(cell_radius > 0);
   return true;
 }
 
@@ -305,12 +305,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     }
     return mask;
   };
-  // Segments follow only the edges of some weight: a colour boundary splits points of one orientation.
-  std::vector<std::pair<int, int>> strong;
-  for (size_t e = 0; e < edges.size(); ++e) {
-    if (weight[e] >= o.min_edge_weight) strong.push_back(edges[e]);
-  }
-  for (const std::vector<int>& members : Components(n, strong, d.orientation)) {
+  for (const std::vector<int>& members : Components(n, edges, d.orientation)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
     DetectedSegment s;
     s.planar = true;
@@ -335,7 +330,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     }
     d.segments.push_back(std::move(s));
   }
-  for (const std::vector<int>& members : Components(n, strong, non_planar)) {
+  for (const std::vector<int>& members : Components(n, edges, non_planar)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
     DetectedSegment s;
     s.points = members;

@@ -231,8 +231,11 @@ TEST(Cli, DetectWritesAnnotationsAndRefusesBadInput) {
   test::TempDir dir;
   ASSERT_EQ(Pdvo("synth -o " + (dir / "s") + " -n 3 --seed 6 --set walk.fps=1 -v warning", dir).code, 0);
   const std::string model = PDVO_SOURCE_DIR "/models/default/model.yml";
-  const CommandResult ok = Pdvo("detect -m " + model + " " + (dir / "s") + " -o " + (dir / "det") + " -v warning", dir);
+  const CommandResult ok =
+      Pdvo("detect -m " + model + " " + (dir / "s") + " -o " + (dir / "det") + " --overlay -v warning", dir);
   ASSERT_EQ(ok.code, 0) << ok.err;
+  const cv::Mat stages = cv::imread(dir / "det/000001_stages.png");
+  EXPECT_EQ(stages.size(), cv::Size(3 * 320, 2 * 240));  // six panels at the working size
   int planes = 0;
   for (const char* name : {"000000.json", "000001.json", "000002.json"}) {
     const std::string path = dir / ("det/" + std::string(name));

@@ -6,7 +6,7 @@
 //   3. A Delaunay graph joins the points; its edges are weighted by distance and by colour contrast. MRF 1
 //      labels points plane / non-plane (data: the planarity; a contrast-sensitive Potts term), exactly by a
 //      graph cut; MRF 2 labels the planar points with orientations found by mean shift on their normals, by
-//      alpha-expansion (mrf.h). Points of one label connected by edges of at least min_edge_weight are a segment.
+//      alpha-expansion (mrf.h). Connected points of one label are a segment.
 //   4. Each segment (its points' Voronoi cells, clipped near the points) is recognised again as a region for its
 //      final normal and plane probability; small segments and those the recognition rejects are dropped.
 // Pixels are the working image's (the model's working width); normals are unit, camera frame, towards the camera.
@@ -41,7 +41,6 @@ struct DetectorOptions {
   int max_orientations = 6;
   double orientation_scale_deg = 20;      // MRF 2's data cost: (angle / scale)^2, at most 4
   double orientation_smoothness = 1.5;    // MRF 2's Potts weight on a full-weight edge
-  double min_edge_weight = 0;       // segments are connected by edges of at least this weight
   int min_segment_points = 10;      // smaller segments are dropped
   double min_plane_probability = 0.5;  // a plane segment recognised again below this is dropped
   double cell_radius = 16;          // px: a segment's area is its points' Voronoi cells within this distance
@@ -68,7 +67,6 @@ struct DetectorOptions {
     visit("max_orientations", self.max_orientations);
     visit("orientation_scale_deg", self.orientation_scale_deg);
     visit("orientation_smoothness", self.orientation_smoothness);
-    visit("min_edge_weight", self.min_edge_weight);
     visit("min_segment_points", self.min_segment_points);
     visit("min_plane_probability", self.min_plane_probability);
     visit("cell_radius", self.cell_radius);
