@@ -160,6 +160,9 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   const PlaneModel& model = recogniser_.model();
   PDVO_THROW_CHECK(!image.empty() && image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 1),
                    InvalidArgument, "detector: the image must be 8-bit BGR or grey and not empty");
+  PDVO_THROW_CHECK(!camera || (camera->width == image.cols && camera->height == image.rows), InvalidArgument,
+                   "detector: the image is " << image.cols << "x" << image.rows << ", its camera "
+                                             << camera->width << "x" << camera->height);
   Detections d;
   cv::Mat work = ToWorkingSize(image, model.options.working_width, &d.scale);
   if (work.channels() == 1) cv::cvtColor(work, work, cv::COLOR_GRAY2BGR);

@@ -114,6 +114,8 @@ TEST(Detector, RefusesImagesItCannotDetectIn) {
   large.window_sizes = {400};  // larger than a 320 x 240 image
   const Detector too_large(detector.recogniser().model(), large);
   EXPECT_THROW(too_large.Detect(cv::Mat(240, 320, CV_8UC3, cv::Scalar(90, 90, 90))), InvalidArgument);
+  EXPECT_THROW(detector.Detect(cv::Mat(240, 320, CV_8UC3), Camera::Pinhole(640, 480, 500, 500, 320, 240)),
+               InvalidArgument);  // a camera of another size
   DetectorOptions bad;
   bad.overlap = 1;
   EXPECT_THROW(Detector(detector.recogniser().model(), bad), InvalidArgument);

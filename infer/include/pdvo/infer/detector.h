@@ -130,8 +130,9 @@ class Detector {
   const DetectorOptions& options() const { return options_; }
 
   // Planes in an 8-bit BGR or grey image of any size (resized to the model's working width); `camera` is the
-  // image's (undistorted) if known. Throws InvalidArgument for an empty image or one smaller than the smallest
-  // window. Const and thread-safe: one detector may serve several threads.
+  // image's (undistorted, of the image's size) if known. Throws InvalidArgument for an empty image, one smaller
+  // than the smallest window, or a camera of another size. Const and thread-safe: one detector may serve several
+  // threads.
   Detections Detect(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
 
  private:
