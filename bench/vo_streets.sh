@@ -1,8 +1,8 @@
 #!/bin/bash
 # The visual odometry's ATE over many synthetic streets: one street says little, since small changes of the
-# options move a single street's ATE by half a point (README.md). Runs build/bench/vo_bench on each seed, two
-# streets at a time (one per core), and prints each street's ATE (% of the path), the mean and how many are
-# above the 1% target.
+# options move a single street's ATE by half a point (docs/experiments/2026-11-odometry.md). Runs
+# build/bench/vo_bench on each seed, two streets at a time (one per core), and prints each street's ATE (% of the
+# path), the mean and how many are above the 1% target.
 # Usage: bench/vo_streets.sh FIRST_SEED LAST_SEED [option=value ...]   e.g. bench/vo_streets.sh 31 42 mode=idpp
 # (seeds 31-42 are the streets the options were tuned on; 1-3 are the benchmark streets of ./run bench)
 set -euo pipefail

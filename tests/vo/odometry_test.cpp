@@ -80,8 +80,8 @@ TEST(Odometry, TracksASyntheticStreetWithBoundedError) {
   EXPECT_EQ(ate.matched, s.walk.size());
   // Measured 1.39% of the path on this street (2.27% with reference cameras tracked in the state); 0.97% without
   // the two-view bootstrap (bootstrap.frames=0): the frames before it keep the two-view's scale, which the filter
-  // revises in the frames after it. Over 1,000 frames the bootstrap helps (README.md). A constant velocity
-  // extrapolation would be off by metres.
+  // revises in the frames after it. Over 1,000 frames the bootstrap helps (docs/experiments/2026-11-odometry.md).
+  // A constant velocity extrapolation would be off by metres.
   EXPECT_LT(ate.translation.rmse, 0.03 * length) << "path " << length << " m";
   RecordProperty("ate_rmse_percent_of_path", std::to_string(100 * ate.translation.rmse / length));
 }
