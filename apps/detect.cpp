@@ -15,14 +15,6 @@
 namespace pdvo::apps {
 namespace {
 
-bool IsImageFile(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return std::filesystem::is_regular_file(path) &&
-         (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".ppm" ||
-          ext == ".pgm");
-}
-
 // A panel at the working size with a title.
 cv::Mat Titled(cv::Mat panel, const char* title) {
   cv::rectangle(panel, cv::Rect(0, 0, panel.cols, 16), cv::Scalar(0, 0, 0), cv::FILLED);
@@ -121,7 +113,7 @@ int RunDetect(int argc, char** argv) {
   if (!annotations_dir.empty()) {
     annotated = ListAnnotationFiles({annotations_dir});
     total = annotated.size();
-  } else if (IsImageFile(input)) {
+  } else if (std::filesystem::is_regular_file(input) && HasImageExtension(input)) {
     single.emplace_back(input, ReadImage(input, cv::IMREAD_COLOR));
   } else {
     sequence = OpenSequence(input);

@@ -21,8 +21,8 @@ bool RegionSamplingOptions::Check() const {
 }
 
 bool Region::Contains(const cv::Point2f& p) const {
-  const int x = static_cast<int>(std::floor(p.x + 0.5f)) - box.x;
-  const int y = static_cast<int>(std::floor(p.y + 0.5f)) - box.y;
+  const cv::Point q = NearestPixel(p);
+  const int x = q.x - box.x, y = q.y - box.y;
   if (x < 0 || y < 0 || x >= box.width || y >= box.height) return false;
   return mask.empty() || mask.at<uchar>(y, x) != 0;
 }

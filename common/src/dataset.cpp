@@ -16,14 +16,14 @@
 namespace pdvo {
 namespace fs = std::filesystem;
 
-namespace {
-
-bool IsImageFile(const fs::path& p) {
-  std::string ext = p.extension().string();
+bool HasImageExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
          ext == ".tiff" || ext == ".ppm" || ext == ".pgm";
 }
+
+namespace {
 
 std::optional<Camera> CameraInFolder(const fs::path& folder) {
   const fs::path yaml = folder / "camera.yaml";
@@ -160,7 +160,7 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
   PDVO_THROW_CHECK(!image_dir.empty(), FormatError, root.string() << ": KITTI folder has no image_0/ or image_l/");
   std::vector<std::string> images;
   for (const auto& e : fs::directory_iterator(image_dir)) {
-    if (e.is_regular_file() && IsImageFile(e.path())) images.push_back(e.path().string());
+    if (e.is_regular_file() && HasImageExtension(e.path().string())) images.push_back(e.path().string());
   }
   std::sort(images.begin(), images.end());
   PDVO_THROW_CHECK(!images.empty(), FormatError, image_dir.string() << ": holds no images");
@@ -198,7 +198,7 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
 std::unique_ptr<Sequence> OpenImageFolder(const fs::path& root, const SequenceOptions& options) {
   std::vector<std::string> images;
   for (const auto& e : fs::directory_iterator(root)) {
-    if (e.is_regular_file() && IsImageFile(e.path())) images.push_back(e.path().string());
+    if (e.is_regular_file() && HasImageExtension(e.path().string())) images.push_back(e.path().string());
   }
   std::sort(images.begin(), images.end());
   PDVO_THROW_CHECK(!images.empty(), FormatError, root.string() << ": holds no images (.png, .jpg, ...)");

@@ -25,11 +25,6 @@ constexpr double kMaxOrientationCost = 4;  // MRF 2's data cost, at most
 using Clock = std::chrono::steady_clock;
 double Ms(Clock::time_point from) { return std::chrono::duration<double, std::milli>(Clock::now() - from).count(); }
 
-// The pixel a point belongs to (as Region::Contains decides).
-cv::Point PixelOf(const cv::Point2f& p) {
-  return {static_cast<int>(std::floor(p.x + 0.5f)), static_cast<int>(std::floor(p.y + 0.5f))};
-}
-
 // The windows of every size and shape on the grid, spread evenly over the image.
 std::vector<cv::Rect> MakeWindows(cv::Size size, const DetectorOptions& o) {
   const int columns = size.width / o.cell, rows = size.height / o.cell;
@@ -119,7 +114,7 @@ PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vect
   std::vector<std::vector<Eigen::Vector3d>> normals(n);
   for (const DetectedWindow& w : windows) {
     for (size_t i = 0; i < n; ++i) {
-      if (!w.box.contains(PixelOf(points[i]))) continue;
+      if (!w.box.contains(NearestPixel(points[i]))) continue;
       probabilities[i].push_back(w.plane_probability);
       normals[i].push_back(w.normal);
     }
@@ -209,7 +204,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   const std::vector<std::pair<int, int>> edges = DelaunayEdges(d.points, work.size());
   std::vector<double> weight;
   for (const auto& [a, b] : edges) {
-    const cv::Point pa = PixelOf(d.points[a]), pb = PixelOf(d.points[b]);
+    const cv::Point pa = NearestPixel(d.points[a]), pb = NearestPixel(d.points[b]);
     const cv::Vec3b ca = work.at<cv::Vec3b>(std::clamp(pa.y, 0, work.rows - 1), std::clamp(pa.x, 0, work.cols - 1));
     const cv::Vec3b cb = work.at<cv::Vec3b>(std::clamp(pb.y, 0, work.rows - 1), std::clamp(pb.x, 0, work.cols - 1));
     const double colour = cv::norm(cv::Vec3d(ca) - cv::Vec3d(cb)) / 255;
@@ -277,14 +272,14 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   t = Clock::now();
   cv::Mat sites(work.size(), CV_8U, cv::Scalar(255)), distance, labels;
   for (const cv::Point2f& p : d.points) {
-    const cv::Point q = PixelOf(p);
+    const cv::Point q = NearestPixel(p);
     if (q.x >= 0 && q.y >= 0 && q.x < work.cols && q.y < work.rows) sites.at<uchar>(q) = 0;
   }
   std::vector<int> point_of_label;
   if (n > 0) {
     cv::distanceTransform(sites, distance, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
     for (int i = 0; i < n; ++i) {
-      const cv::Point q = PixelOf(d.points[i]);
+      const cv::Point q = NearestPixel(d.points[i]);
       if (q.x < 0 || q.y < 0 || q.x >= work.cols || q.y >= work.rows) continue;
       const int label = labels.at<int>(q);
       if (label >= static_cast<int>(point_of_label.size())) point_of_label.resize(label + 1, -1);

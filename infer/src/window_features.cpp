@@ -57,7 +57,8 @@ WindowFeatures::WindowFeatures(const ImageWords& words, const PlaneModel& model,
   auto at = [&](int row, int column) { return &table_[(static_cast<size_t>(row) * (columns_ + 1) + column) * channels_]; };
   for (size_t i = 0; i < words.size(); ++i) {
     const cv::Point2f& p = words.points[i];
-    const int px = static_cast<int>(std::floor(p.x + 0.5f)), py = static_cast<int>(std::floor(p.y + 0.5f));
+    const cv::Point pixel = NearestPixel(p);
+    const int px = pixel.x, py = pixel.y;
     const int column = px / cell_, row = py / cell_;
     if (px < 0 || py < 0 || column >= columns_ || row >= rows_) continue;  // in no aligned window
     const int gw = words.gradient[i], cw = words.colour[i];

@@ -76,9 +76,9 @@ struct Odometry::Impl {
     } else {
       filter->Predict(timestamp - last_time, o.motion);
       tracks.LeaveView(camera, o.features.border, filter.get(), &record);
-      const std::vector<PointMeasurement> matches = SearchFeatures(grey, &stats);
-      const RobustUpdateResult update = UpdateRobustly(camera, o.ransac, matches, &rng, filter.get());
-      Tally(update, &stats);
+      const Search search = SearchFeatures(grey, &stats);
+      const RobustUpdateResult update = UpdateRobustly(camera, o.ransac, search.matches, &rng, filter.get());
+      Tally(search, update, &stats);
       tracks.LeaveRejected(o.features, filter.get(), &record);
       grower.Grow(filter.get(), &tracks, &record);
       if (Lost()) {
@@ -136,14 +136,18 @@ struct Odometry::Impl {
     MakeKeyframe(grey, timestamp, priors);
   }
 
+  // The matches of a frame's search, and per match its feature's history and its observation.
+  struct Search {
+    std::vector<PointMeasurement> matches;
+    std::vector<std::pair<History*, size_t>> searched;
+  };
   // Searches for every feature in view (at most max_measurements): predicts its pixel and innovation
   // covariance, warps its keyframe patch by its plane's homography (a point's: fronto-parallel), and searches by
-  // NCC inside the innovation ellipse. Returns the matches; observations get every feature searched for.
-  std::vector<PointMeasurement> SearchFeatures(const cv::Mat& grey, FrameStats* stats) {
+  // NCC inside the innovation ellipse. Observations get every feature searched for.
+  Search SearchFeatures(const cv::Mat& grey, FrameStats* stats) {
     const Rigid3d current = filter->camera().world_from_cam();
     const cv::Size size(camera.width, camera.height);
-    std::vector<PointMeasurement> matches;
-    searched_.clear();
+    Search out;
     Eigen::Vector2d pixel;
     Eigen::MatrixXd jacobian;
     auto search = [&](int id, int plane, const Eigen::Vector3d& ray, int reference, const Eigen::Matrix3d& h,
@@ -157,8 +161,8 @@ struct Odometry::Impl {
       const bool matched = WarpPatch(keyframe.grey, h, pixel, o.search.patch_half, &patch) &&
                            SearchPatch(grey, patch, pixel, s, o.search, &found);
       if (matched) {
-        matches.push_back({id, found, o.search.pixel_sigma, ray});
-        searched_.emplace_back(history, observations.size());
+        out.matches.push_back({id, found, o.search.pixel_sigma, ray});
+        out.searched.emplace_back(history, observations.size());
         history->misses = 0;
       } else {
         ++history->misses;
@@ -186,17 +190,15 @@ struct Odometry::Impl {
         search(id, id, m.ray, plane.reference, h, m.keyframe_pixel, &m.history);
       }
     }
-    return matches;
+    return out;
   }
-  // Per match of the last search: its feature's history and its observation.
-  std::vector<std::pair<History*, size_t>> searched_;
 
   // The update's outcome in the features' histories, the observations and the frame's statistics.
-  void Tally(const RobustUpdateResult& update, FrameStats* stats) {
+  void Tally(const Search& search, const RobustUpdateResult& update, FrameStats* stats) {
     for (size_t i = 0; i < update.used.size(); ++i) {
-      ++searched_[i].first->matched;
-      searched_[i].first->rejected += !update.used[i];
-      observations[searched_[i].second].used = update.used[i];
+      ++search.searched[i].first->matched;
+      search.searched[i].first->rejected += !update.used[i];
+      observations[search.searched[i].second].used = update.used[i];
     }
     stats->update = update.status;
     stats->measurements = static_cast<int>(std::count(update.used.begin(), update.used.end(), true));

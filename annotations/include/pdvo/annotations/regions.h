@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -36,6 +37,11 @@ struct RegionSamplingOptions {
   bool Check() const;
   bool operator==(const RegionSamplingOptions&) const = default;
 };
+
+// The pixel a point (pixel coordinates, (0, 0) the centre of the top-left pixel) falls in.
+inline cv::Point NearestPixel(const cv::Point2f& p) {
+  return {static_cast<int>(std::floor(p.x + 0.5f)), static_cast<int>(std::floor(p.y + 0.5f))};
+}
 
 // An image region: a box and, for polygons, a mask of the box's size (empty: the whole box).
 struct Region {

@@ -55,6 +55,9 @@ class Sequence {
 
 // Opens the sequence at `path`; throws IoError if it does not exist and FormatError if it holds no frames or
 // its index files are malformed.
+// True if the path ends in an image extension the readers take (.png .jpg .jpeg .bmp .tif .tiff .ppm .pgm, any case).
+bool HasImageExtension(const std::string& path);
+
 std::unique_ptr<Sequence> OpenSequence(const std::string& path, const SequenceOptions& options = {});
 
 // A TUM list file (`timestamp path` per line, '#' comments): returns (time, path relative to the folder).
