@@ -1,5 +1,8 @@
-// pdvo vo: monocular visual odometry (the IDPP EKF: inverse-depth points and planes) over a sequence.
+// pdvo vo: monocular visual odometry (the IDPP EKF: inverse-depth points and planes) over a sequence, with the
+// plane detector's planes as priors in mode pdvo.
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -12,16 +15,23 @@
 #include "pdvo/common/trajectory.h"
 #include "pdvo/vo/frames.h"
 #include "pdvo/vo/odometry.h"
+#include "plane_sources.h"
 #include "tool.h"
 
 namespace pdvo::apps {
 namespace {
 
 // The frame with its features: points green, plane points in a colour per plane; filled where the update used
-// the match, hollow where the search failed, red where RANSAC rejected the match.
+// the match, hollow where the search failed, red where RANSAC rejected the match. The polygons of the newest
+// detections (keyframe pixels) in yellow.
 cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations,
-                    const vo::FrameStats& s) {
+                    const vo::FrameStats& s, const std::vector<DetectedPlane>& detected) {
   cv::Mat out = colour.clone();
+  for (const DetectedPlane& p : detected) {
+    std::vector<cv::Point> outline;
+    for (const Eigen::Vector2d& q : p.polygon) outline.emplace_back(cvRound(q.x()), cvRound(q.y()));
+    cv::polylines(out, std::vector<std::vector<cv::Point>>{outline}, true, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
+  }
   for (const vo::Observation& o : observations) {
     const cv::Scalar c = o.matched && !o.used ? cv::Scalar(0, 0, 255)
                          : o.plane < 0        ? cv::Scalar(0, 220, 0)
@@ -35,6 +45,25 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
                 s.attempted, s.points, s.planes, s.lost ? "  LOST" : "");
   cv::putText(out, text, cv::Point(4, 12), cv::FONT_HERSHEY_PLAIN, 0.8, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   return out;
+}
+
+// A keyframe's detections in stats.json.
+nlohmann::json DetectionJson(const vo::DetectionEvent& e, double now) {
+  const vo::SeedingOutcome& o = e.seeding;
+  nlohmann::json j = {{"keyframe", e.result.keyframe},
+                      {"started", e.result.started},
+                      {"applied", e.result.delivered},
+                      {"latency_frames", e.result.delivered - e.result.keyframe},
+                      {"latency_seconds", now - e.result.keyframe_time},
+                      {"detector_seconds", e.result.seconds},
+                      {"detected", e.result.planes.size()},
+                      {"seeded", o.seeded},
+                      {"discarded", {{"small", o.small}, {"too_many", o.too_many}, {"near_plane", o.near_plane},
+                                     {"mapped", o.mapped},
+                                     {"no_corner", o.no_corner}, {"grazing", o.grazing}, {"invalid", o.invalid}}},
+                      {"keyframe_gone", e.keyframe_gone}};
+  if (!e.result.error.empty()) j["error"] = e.result.error;
+  return j;
 }
 
 }  // namespace
@@ -54,7 +83,15 @@ int RunVo(int argc, char** argv) {
       ->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML (default: the sequence's own)");
   app.add_option("--out,-o", out_dir, "Output folder")->required();
-  app.add_option("--mode", mode, "idpp (points and planes) or points (default: the options' mode, points)");
+  app.add_option("--mode", mode,
+                 "pdvo (planes where the detector finds them), idpp (planes where corners are densest) or points "
+                 "(default: pdvo if the model file is there and no --config or --set says otherwise, else points)");
+  std::string model_path = "models/default/model.yml", source = "model";
+  app.add_option("--model,-m", model_path, "Plane model file, for --mode pdvo")->capture_default_str();
+  app.add_option("--detections", source,
+                 "Mode pdvo's planes: model (the detector), oracle (the sequence's own annotations: pdvo synth "
+                 "output), or a folder of annotation files matched to frames by image name")
+      ->capture_default_str();
   app.add_option("--format", format_name, "Trajectory format: tum or kitti")->capture_default_str();
   app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
   app.add_flag("--overlay", overlay,
@@ -66,6 +103,10 @@ int RunVo(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
+  const bool mode_set = !mode.empty() || !config_path.empty() ||
+                        std::any_of(overrides.begin(), overrides.end(),
+                                    [](const std::string& o) { return o.rfind("mode=", 0) == 0; });
+  if (!mode_set && std::filesystem::exists(model_path)) mode = "pdvo";
   if (!mode.empty()) overrides.push_back("mode=" + mode);
   const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
   const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
@@ -74,14 +115,20 @@ int RunVo(int argc, char** argv) {
   const vo::FramePreparer preparer(camera, options.working_width);
   const Camera& working = preparer.working_camera();
   const int width = working.width, height = working.height;
-  vo::Odometry odometry(working, options);
-  PDVO_LOG(Info) << "vo on " << sequence->Describe() << " at " << width << "x" << height;
+  const bool pdvo = options.mode == vo::PlaneMode::kPdvo;
+  std::unique_ptr<PlaneSource> planes;
+  if (pdvo) planes = std::make_unique<PlaneSource>(source, model_path, sequence_path, working);
+  vo::Odometry odometry(working, options, nullptr, planes ? planes->detector() : vo::PlaneDetector());
+  PDVO_LOG(Info) << "vo (mode " << OptionName(options.mode) << ") on " << sequence->Describe() << " at " << width
+                 << "x" << height << (planes ? ", planes from " + planes->Describe() : "");
 
   StagedOutputDir out(out_dir);
   SaveOptions(out.path("vo.yaml"), options, "vo");
   size_t tracked = 0;
-  nlohmann::json frames = nlohmann::json::array();
-  double seconds = 0;
+  nlohmann::json frames = nlohmann::json::array(), detections = nlohmann::json::array();
+  std::vector<DetectedPlane> newest_detections;  // for the overlay
+  int keyframes_gone = 0;
+  double seconds = 0, waited = 0;
   int lost = 0, keyframes = 0, update_failures = 0;
   const size_t total = max_frames > 0 ? std::min(max_frames, sequence->size()) : sequence->size();
   Progress progress("vo", total);
@@ -96,18 +143,25 @@ int RunVo(int argc, char** argv) {
                      frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
                                       << ", the camera says " << camera.width << "x" << camera.height);
     const vo::PreparedFrame prepared = preparer.Prepare(frame.image);
-    const vo::FrameStats s = odometry.Track(prepared.grey, frame.timestamp);
+    if (planes) planes->AddFrame(static_cast<int>(tracked), frame.image_path);
+    const vo::FrameStats s = odometry.Track(prepared.grey, frame.timestamp, prepared.colour);
+    for (const vo::DetectionEvent& e : s.detections) {
+      detections.push_back(DetectionJson(e, frame.timestamp));
+      keyframes_gone += e.keyframe_gone;
+      if (e.result.error.empty()) newest_detections = e.result.planes;
+    }
     seconds += s.seconds;
     lost += s.lost;
     keyframes += s.keyframe;
     ++tracked;
+    waited += s.detector_wait_seconds;
     frames.push_back({{"t", s.timestamp}, {"seconds", s.seconds}, {"attempted", s.attempted},
                       {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
-                      {"plane_points", s.plane_points},
+                      {"plane_points", s.plane_points}, {"plane_measurements", s.plane_measurements},
                       {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost},
                       {"bootstrap", s.bootstrap}, {"update", vo::ToString(s.update)}});
     update_failures += s.update != vo::UpdateStatus::kOk && s.update != vo::UpdateStatus::kNoMeasurements;
-    if (overlay) video.write(DrawOverlay(prepared.colour, odometry.observations(), s));
+    if (overlay) video.write(DrawOverlay(prepared.colour, odometry.observations(), s, newest_detections));
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
                      std::to_string(s.planes) + " planes");
     progress.Step();
@@ -136,12 +190,32 @@ int RunVo(int argc, char** argv) {
                                  {"mean_plane_area_px", mapping.mean_plane_area},
                                  {"map_points", map.points.size()},
                                  {"map_planes", map.planes.size()}};
-  WriteFileAtomically(out.path("stats.json"), nlohmann::json({{"totals", totals}, {"frames", frames}}).dump(1) + "\n");
+  nlohmann::json stats = {{"totals", totals}, {"frames", frames}};
+  if (pdvo) {
+    const vo::Odometry::DetectionCounts counts = odometry.detection_counts();
+    int detected = 0, seeded = 0;
+    for (const nlohmann::json& d : detections) {
+      detected += d["detected"].get<int>();
+      seeded += d["seeded"].get<int>();
+    }
+    stats["totals"]["detections"] = {{"keyframes_detected", detections.size()}, {"skipped", counts.skipped},
+                                     {"timed_out", counts.timed_out}, {"failed", counts.failed},
+                                     {"keyframe_gone", keyframes_gone}, {"planes_detected", detected},
+                                     {"planes_seeded", seeded}};
+    stats["totals"]["detector_wait_seconds"] = waited;
+    stats["detections"] = detections;
+    if (counts.timed_out > 0) {
+      PDVO_LOG(Warning) << "vo: " << counts.timed_out << " detections took longer than pdvo.timeout_seconds and "
+                        << "were given up: the trajectory may differ from run to run";
+    }
+  }
+  WriteFileAtomically(out.path("stats.json"), stats.dump(1) + "\n");
   out.Commit();
-  std::printf("%zu frames, tracking %.1f frames/s (one thread), %d keyframes, lost %d times; %d planes, %.1f "
-              "points per plane, mean area %.0f px; wrote %s\n",
-              trajectory.size(), fps, keyframes, lost, mapping.planes, mapping.points_per_plane,
-              mapping.mean_plane_area, out_dir.c_str());
+  std::printf("%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times; %d planes, "
+              "%.1f points per plane, mean area %.0f px; wrote %s\n",
+              trajectory.size(), fps,
+              waited > 0 ? (", and it waited " + std::to_string(waited).substr(0, 5) + " s for the detector").c_str() : "",
+              keyframes, lost, mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, out_dir.c_str());
   return 0;
 }
 

@@ -4,18 +4,27 @@
 // monocular VO observes without scale, against the ground truth expressed in the first camera's frame), and the
 // resident memory of tracking (rendered frames excluded). The NEES takes the camera the filter fixed when it
 // started (the first frame, or the frame of the two-view bootstrap) as exact. In idpp mode, the purity of the
-// planes: how many of their points lie on the same true surface.
-// Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5)
+// planes: how many of their points lie on the same true surface, and the median error of their normals.
+// In pdvo mode the planes come from `source=model` (the detector with the shipped model, or model=PATH) or
+// `source=oracle` (the street's exact annotation of each keyframe); the tracking thread's time is its CPU time
+// (the detector's thread excluded; the deterministic schedule's waits excluded).
+// Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5,
+//        and for mode=pdvo source=model|oracle model=PATH)
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <array>
 #include <map>
+#include <set>
 
 #include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 
+#include "pdvo/annotations/annotation.h"
 #include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
+#include "pdvo/infer/detector.h"
 #include "memory.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
@@ -24,16 +33,29 @@
 
 using pdvo::bench::ResidentMiB;
 
+namespace {
+double ThreadSeconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   pdvo::vo::VoOptions vo_options;
+  std::string source = "model", model_path = std::string(PDVO_SOURCE_DIR) + "/models/default/model.yml";
   for (int i = 3; i < argc; ++i) {
     const std::string arg = argv[i];
     const size_t eq = arg.find('=');
     if (eq == std::string::npos) {
       std::fprintf(stderr, "vo_bench: expected option=value, got '%s'\n", argv[i]);
       return 2;
+    }
+    if (arg.substr(0, eq) == "source" || arg.substr(0, eq) == "model") {
+      (arg.substr(0, eq) == "source" ? source : model_path) = arg.substr(eq + 1);
+      continue;
     }
     try {
       pdvo::SetOption(vo_options, arg.substr(0, eq), arg.substr(eq + 1));
@@ -47,16 +69,39 @@ int main(int argc, char** argv) {
   const double length = options.walk.speed * frames / options.walk.fps;
   const pdvo::sim::Street street = pdvo::sim::GenerateStreet(options.street, length + 30, seed);
   const pdvo::Trajectory walk = pdvo::sim::WalkStreet(street, options.walk, frames, seed);
-  std::vector<cv::Mat> grey;
+  std::vector<cv::Mat> grey, colour;
   const pdvo::sim::Renderer renderer(street, camera, options.render, seed);
   const pdvo::vo::FramePreparer preparer(camera, vo_options.working_width);  // as pdvo vo prepares frames
+  const bool pdvo_mode = vo_options.mode == pdvo::vo::PlaneMode::kPdvo;
   for (const pdvo::StampedPose& pose : walk) {
     pdvo::sim::RenderedFrame frame;
     renderer.Render({pose.world_from_cam}, pose.timestamp, grey.size(), &frame);
-    grey.push_back(preparer.Prepare(frame.image).grey);
+    const pdvo::vo::PreparedFrame prepared = preparer.Prepare(frame.image);
+    grey.push_back(prepared.grey);
+    if (pdvo_mode) colour.push_back(prepared.colour);
+  }
+  const pdvo::Camera& working = preparer.working_camera();
+  pdvo::vo::PlaneDetector detect;
+  std::unique_ptr<pdvo::Detector> detector;
+  if (pdvo_mode && source == "model") {
+    detector = std::make_unique<pdvo::Detector>(pdvo::PlaneModel::Read(model_path), pdvo::DetectorOptions());
+    detect = [&](const pdvo::vo::KeyframeImage& k) {
+      return detector->Detect(k.colour, working).Planes(working.width, working.height);
+    };
+  } else if (pdvo_mode && source == "oracle") {
+    detect = [&](const pdvo::vo::KeyframeImage& k) {
+      pdvo::sim::RenderedFrame geometry;
+      renderer.RenderGeometry(walk.at(k.frame).world_from_cam, &geometry);
+      const pdvo::Annotation a =
+          pdvo::sim::AnnotateFrame(street, geometry, walk.at(k.frame).world_from_cam, camera, "");
+      return pdvo::DetectedPlanes(a, working.width);
+    };
+  } else if (pdvo_mode) {
+    std::fprintf(stderr, "vo_bench: source is model or oracle, not '%s'\n", source.c_str());
+    return 2;
   }
   const double before = ResidentMiB();
-  pdvo::vo::Odometry odometry(preparer.working_camera(), vo_options);
+  pdvo::vo::Odometry odometry(working, vo_options, nullptr, detect);
   int keyframes = 0, lost = 0, bootstrap = -1;
   double measurements = 0, peak = before, nees_sum = 0, relative_nees_sum = 0;
   // The newest keyframe's orientation, estimated and true.
@@ -71,9 +116,23 @@ int main(int argc, char** argv) {
   // The filter fixes the orientation of the camera it starts at (the gauge), the first frame's and again the
   // frame of a restart (bootstrap or lost): the truth is compared in that camera's frame.
   Eigen::Quaterniond gauge = walk.front().world_from_cam.rotation.conjugate();
+  std::map<std::pair<int, int>, Eigen::Vector3d> normals;  // (keyframe, plane id): its last normal, keyframe frame
+  int detected = 0, seeded = 0, dropped = 0;
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadSeconds();
+  std::vector<double> frame_cpu;  // the tracking thread's CPU time per frame
+  // Per plane (keyframe, id): its used measurements by frames since its keyframe (the paper's Fig. 4).
+  constexpr int kCurveFrames = 90;
+  std::map<std::pair<int, int>, std::array<int, kCurveFrames>> measured_after;
   for (size_t k = 0; k < grey.size(); ++k) {
-    const pdvo::vo::FrameStats s = odometry.Track(grey[k], walk[k].timestamp);
+    const double frame_start = ThreadSeconds();
+    const pdvo::vo::FrameStats s = odometry.Track(grey[k], walk[k].timestamp, pdvo_mode ? colour[k] : cv::Mat());
+    frame_cpu.push_back(ThreadSeconds() - frame_start);
+    for (const pdvo::vo::DetectionEvent& e : s.detections) {
+      detected += e.seeding.detected;
+      seeded += e.seeding.seeded;
+      dropped += e.keyframe_gone;
+    }
     keyframes += s.keyframe;
     if (s.bootstrap) bootstrap = static_cast<int>(k);
     lost += s.lost;
@@ -103,10 +162,21 @@ int main(int argc, char** argv) {
       if (o.plane >= 0) {
         const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
         members.push_back({static_cast<int>(k), o.plane, keyframe, o.keyframe_pixel});
+        const int age = static_cast<int>(k) - keyframe;
+        if (o.used && age >= 0 && age < kCurveFrames) {
+          auto [it, added] = measured_after.try_emplace({keyframe, o.plane});
+          if (added) it->second.fill(0);
+          ++it->second[age];
+        }
+        const auto plane = odometry.filter().planes().find(o.plane);
+        if (plane != odometry.filter().planes().end()) {
+          normals[{keyframe, o.plane}] = plane->second.plane.normal.normalized();
+        }
       }
     }
     if (k % 100 == 0) peak = std::max(peak, ResidentMiB());
   }
+  const double cpu_seconds = ThreadSeconds() - cpu_start;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   peak = std::max(peak, ResidentMiB());
   const pdvo::AteResult ate = pdvo::ComputeAte(walk, odometry.trajectory(), pdvo::Alignment::kSim3, 1e-3);
@@ -117,6 +187,9 @@ int main(int argc, char** argv) {
   // on their plane's most common surface.
   std::map<int, cv::Mat> surfaces;  // by keyframe: the true ids
   pdvo::PlanePurity purity;
+  // Per mapped plane (keyframe, id): the true planes under its points, and its points' keyframe pixels.
+  std::map<std::pair<int, int>, std::map<int, int>> true_planes;
+  std::map<std::pair<int, int>, std::set<std::pair<int, int>>> plane_pixels;
   for (const Member& m : members) {
     cv::Mat& id = surfaces[m.keyframe];
     if (id.empty()) {
@@ -126,12 +199,53 @@ int main(int argc, char** argv) {
     }
     const int at = id.at<int>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
     purity.Add(m.frame, m.plane, at >= 0 ? street.planes.at(at).surface : -1);
+    ++true_planes[{m.keyframe, m.plane}][at];
+    plane_pixels[{m.keyframe, m.plane}].insert({cvRound(m.keyframe_pixel.x()), cvRound(m.keyframe_pixel.y())});
   }
+  // Normal error: each plane of min_plane_points or more against the true plane under most of its points, in the
+  // keyframe's camera frame (the estimated keyframe orientation's error is part of it).
+  std::vector<double> normal_errors;
+  for (const auto& [key, votes] : true_planes) {
+    if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points || !normals.count(key)) {
+      continue;
+    }
+    const auto main = std::max_element(votes.begin(), votes.end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (std::getenv("VO_BENCH_PLANES")) {
+      std::printf("plane k%d id%d:", key.first, key.second);
+      for (const auto& [pid, n] : votes) {
+        if (pid >= 0) {
+          const auto& sp = street.planes.at(pid);
+          std::printf(" [%d s%d n(%.2f %.2f %.2f) d%.1f]x%d", pid, sp.surface, sp.normal.x(), sp.normal.y(),
+                      sp.normal.z(), sp.distance, n);
+        } else {
+          std::printf(" [none]x%d", n);
+        }
+      }
+      std::printf("\n");
+    }
+    if (main->first < 0) continue;
+    const Eigen::Vector3d truth =
+        walk.at(key.first).world_from_cam.rotation.conjugate() * street.planes.at(main->first).normal;
+    const double c = std::min(1.0, std::abs(truth.normalized().dot(normals.at(key))));
+    normal_errors.push_back(std::acos(c) * 180 / M_PI);
+  }
+  std::sort(normal_errors.begin(), normal_errors.end());
+  // The mean plane's measurements by frames since its keyframe, over the planes of min_plane_points or more.
+  std::array<double, kCurveFrames> curve{};
+  int curve_planes = 0;
+  for (const auto& [key, counts] : measured_after) {
+    if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points) continue;
+    ++curve_planes;
+    for (int a = 0; a < kCurveFrames; ++a) curve[a] += counts[a];
+  }
+  for (double& c : curve) c /= std::max(1, curve_planes);
   long plane_members = 0;
   const double pure = purity.Share(4, &plane_members);
   std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,
               static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(), path);
-  std::printf("  tracking         %.1f frames/s (one thread; target >= 200)\n", frames / seconds);
+  std::printf("  tracking         %.1f frames/s (one thread; target >= 200); tracking thread's CPU %.1f frames/s\n",
+              frames / seconds, frames / cpu_seconds);
   std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n",
               ate.translation.rmse, 100 * ate.translation.rmse / path, ate.translation.max);
   std::printf("  NEES orientation mean %.2f (chi-square(3): 3), %.1f%% of frames inside the 95%% bound (7.81); "
@@ -145,6 +259,32 @@ int main(int argc, char** argv) {
   }
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
               mapping.points_per_plane, mapping.mean_plane_area);
+  if (!normal_errors.empty()) {
+    std::printf("  plane normals    median error %.1f deg over %zu planes\n", normal_errors[normal_errors.size() / 2],
+                normal_errors.size());
+  }
+  if (pdvo_mode) {
+    const pdvo::vo::Odometry::DetectionCounts counts = odometry.detection_counts();
+    std::printf("  detections       source %s: %d planes detected, %d seeded; %d keyframes dropped (left the "
+                "filter), %d skipped, %d timed out, %d failed\n",
+                source.c_str(), detected, seeded, dropped, counts.skipped, counts.timed_out, counts.failed);
+  }
+  // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
+  std::printf("result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
+              "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu seeded=%d curve=",
+              static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
+              pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds,
+              mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
+              normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(), seeded);
+  for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
+  std::printf(" fps_by_100_frames=");
+  for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
+    double t = 0;
+    size_t n = 0;
+    for (size_t k = w * 100; k < std::min(frame_cpu.size(), (w + 1) * 100); ++k, ++n) t += frame_cpu[k];
+    std::printf("%s%.1f", w ? "," : "", n / std::max(t, 1e-9));
+  }
+  std::printf("\n");
   std::printf("  memory           %.1f MiB resident with the frames, tracking added %.1f MiB (peak %.1f MiB)\n",
               before, peak - before, peak);
   return 0;

@@ -201,6 +201,21 @@ double PolygonArea(const std::vector<Eigen::Vector2d>& polygon) {
   return std::abs(twice) / 2;
 }
 
+std::vector<DetectedPlane> DetectedPlanes(const Annotation& a, int width) {
+  PDVO_THROW_CHECK(a.image_width > 0 && width > 0, InvalidArgument,
+                   "DetectedPlanes: image width " << a.image_width << " to " << width);
+  const double scale = static_cast<double>(width) / a.image_width;
+  std::vector<DetectedPlane> out;
+  for (const AnnotationShape& s : a.shapes) {
+    if (!s.IsPlane() || !s.normal) continue;
+    DetectedPlane& p = out.emplace_back();
+    for (const Eigen::Vector2d& q : s.points) p.polygon.push_back(scale * q);
+    p.normal = s.normal->normalized();
+    p.score = s.score.value_or(1.0);
+  }
+  return out;
+}
+
 std::vector<ValidationIssue> Validate(const Annotation& a) {
   std::vector<ValidationIssue> issues;
   auto error = [&](int shape, std::string message) { issues.push_back({true, shape, std::move(message)}); };

@@ -367,4 +367,18 @@ Annotation Detections::ToAnnotation(const std::string& image_path, int width, in
   return a;
 }
 
+std::vector<DetectedPlane> Detections::Planes(int width, int height) const {
+  std::vector<DetectedPlane> planes = DetectedPlanes(ToAnnotation("", width, height), width);
+  const double to_image = static_cast<double>(width) / std::max(1, image_size.width);
+  for (DetectedPlane& p : planes) {
+    std::vector<cv::Point2f> contour;
+    for (const Eigen::Vector2d& q : p.polygon) contour.emplace_back(q.x(), q.y());
+    for (size_t i = 0; i < points.size(); ++i) {
+      const cv::Point2f q(points[i].x * to_image, points[i].y * to_image);
+      if (plane_label[i] == 1 && cv::pointPolygonTest(contour, q, false) >= 0) p.points.emplace_back(q.x, q.y);
+    }
+  }
+  return planes;
+}
+
 }  // namespace pdvo

@@ -10,51 +10,10 @@
 #include "pdvo/common/errors.h"
 #include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
-#include "pdvo/sim/renderer.h"
-#include "pdvo/sim/synth.h"
+#include "test_street.h"
 
 namespace pdvo::vo {
 namespace {
-
-struct Street {
-  sim::SynthOptions options;
-  sim::Street street;
-  Trajectory walk;
-  std::vector<cv::Mat> grey;
-  std::vector<cv::Mat> depth;  // CV_32F, z in metres, 0 for the sky
-  std::vector<cv::Mat> surface;  // CV_16S: the true surface (coplanar polygons share one), -1 for anything else
-  Camera camera;
-};
-
-// 150 frames at 30 frames/s: 7 m of walking.
-const Street& TestStreet() {
-  static const Street s = [] {
-    Street s;
-    constexpr int kFrames = 150;
-    s.street = sim::GenerateStreet(s.options.street, 40, 3);
-    s.walk = sim::WalkStreet(s.street, s.options.walk, kFrames, 3);
-    s.camera = s.options.MakeCamera();
-    const sim::Renderer renderer(s.street, s.camera, s.options.render, 3);
-    for (const StampedPose& pose : s.walk) {
-      sim::RenderedFrame frame;
-      renderer.Render({pose.world_from_cam}, pose.timestamp, s.grey.size(), &frame);
-      cv::Mat grey;
-      cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
-      s.grey.push_back(grey);
-      s.depth.push_back(frame.depth);
-      cv::Mat surface(frame.id.size(), CV_16S);
-      for (int y = 0; y < surface.rows; ++y) {
-        for (int x = 0; x < surface.cols; ++x) {
-          const int id = frame.id.at<int>(y, x);
-          surface.at<int16_t>(y, x) = static_cast<int16_t>(id >= 0 ? s.street.planes.at(id).surface : -1);
-        }
-      }
-      s.surface.push_back(surface);
-    }
-    return s;
-  }();
-  return s;
-}
 
 Trajectory RunOdometry(const Street& s, std::vector<FrameStats>* stats, const VoOptions& options = {},
                        MappingStats* mapping = nullptr) {
@@ -238,31 +197,13 @@ TEST(Odometry, IdppModeGrowsPlanes) {
   RecordProperty("idpp_planes", std::to_string(mapping.planes));
 }
 
-// A plane's points lie on one true surface: in every frame, of the points of each plane in view (4 or more),
-// the share on the plane's most common surface (by the rendered ids at their keyframe pixels).
-double PurityOfPlanes(const Street& s, const VoOptions& options) {
-  Odometry odometry(s.camera, options);
-  PlanePurity purity;
-  for (size_t k = 0; k < s.grey.size(); ++k) {
-    odometry.Track(s.grey[k], s.walk[k].timestamp);
-    for (const Observation& o : odometry.observations()) {
-      if (o.plane < 0) continue;
-      const size_t key = static_cast<size_t>(std::lround(o.keyframe_time * s.options.walk.fps));
-      purity.Add(static_cast<int>(k), o.plane,
-                 s.surface.at(key).at<int16_t>(cvRound(o.keyframe_pixel.y()), cvRound(o.keyframe_pixel.x())));
-    }
-  }
-  long points = 0;
-  const double share = purity.Share(4, &points);
-  EXPECT_GT(points, 80);  // plane points counted: 86 with the default options on this street
-  return share;
-}
-
 TEST(Odometry, PlanePointsLieOnOneSurface) {
   const Street& s = TestStreet();
   VoOptions options;
   options.mode = PlaneMode::kIdpp;
-  const double purity = PurityOfPlanes(s, options);
+  long points = 0;
+  const double purity = PurityOfPlanes(s, options, {}, &points);
+  EXPECT_GT(points, 80);  // plane points counted: 86 with the default options on this street
   options.planes.join_gate = 3;
   const double loose = PurityOfPlanes(s, options);
   // Measured on this street: 0.77 with the default gate of 2 standard deviations, 0.35 with 3.

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
 
 namespace pdvo::vo {
@@ -32,7 +33,7 @@ bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(working_width == 0 || working_width >= 64);
   PDVO_CHECK_OPTION(lost_after >= 1);
   if (!features.Check() || !search.Check() || !ransac.Check() || !prior.Check() || !bootstrap.Check() ||
-      !motion.Check() || !planes.Check()) {
+      !motion.Check() || !planes.Check() || !pdvo.Check()) {
     return false;
   }
   PDVO_CHECK_OPTION(features.border > search.patch_half);
@@ -41,14 +42,19 @@ bool VoOptions::Check() const {
 }
 
 struct Odometry::Impl {
-  Impl(const Camera& c, const VoOptions& options, std::unique_ptr<PlaneSeeder> s)
+  Impl(const Camera& c, const VoOptions& options, std::unique_ptr<PlaneSeeder> s, PlaneDetector detector)
       : camera(c),
         o(options),
         seeder(s ? std::move(s) : MakePlaneSeeder(options.mode, options.planes)),
         grower(c, options.planes, options.features, options.prior.inverse_depth_sigma / options.prior.inverse_depth),
         bootstrap(c, options.bootstrap, options.features.border, options.features.min_distance,
                   options.prior.inverse_depth),
-        record(options.planes.min_plane_points) {}
+        record(options.planes.min_plane_points) {
+    if (detector) {
+      detections = std::make_unique<DetectionWorker>(std::move(detector), o.pdvo.schedule, o.pdvo.delay_frames,
+                                                     o.pdvo.timeout_seconds);
+    }
+  }
 
   Camera camera;
   VoOptions o;
@@ -61,11 +67,13 @@ struct Odometry::Impl {
   Trajectory trajectory;                  // every frame's pose
   std::vector<Observation> observations;  // of the last frame
   std::mt19937 rng{1};                    // RANSAC; fixed seed: the same frames give the same trajectory
+  std::unique_ptr<DetectionWorker> detections;  // mode pdvo
+  int detections_failed = 0;
   double last_time = 0;
   bool started = false;
   int frames_without_measurements = 0;
 
-  FrameStats Track(const cv::Mat& grey, double timestamp) {
+  FrameStats Track(const cv::Mat& grey, double timestamp, const cv::Mat& colour) {
     FrameStats stats;
     stats.timestamp = timestamp;
     observations.clear();
@@ -98,6 +106,7 @@ struct Odometry::Impl {
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
       }
     }
+    if (detections) Detect(timestamp, colour, &stats);
     last_time = timestamp;
     trajectory.push_back({timestamp, filter->camera().world_from_cam()});
     stats.points = static_cast<int>(filter->points().size());
@@ -105,6 +114,36 @@ struct Odometry::Impl {
     stats.plane_points = tracks.PlanePoints();
     stats.state_size = filter->size();
     return stats;
+  }
+
+  // Mode pdvo, at the end of a frame: the detections that arrive now are seeded in their keyframes (or dropped
+  // if it has left), and a new keyframe goes to the detector.
+  void Detect(double timestamp, const cv::Mat& colour, FrameStats* stats) {
+    const int frame = static_cast<int>(trajectory.size());
+    for (DetectionResult& result : detections->Collect(frame, &stats->detector_wait_seconds)) {
+      DetectionEvent& event = stats->detections.emplace_back();
+      event.result = std::move(result);
+      if (!event.result.error.empty()) {
+        if (detections_failed++ == 0) {
+          PDVO_LOG(Warning) << "vo: the plane detector failed at the keyframe of frame " << event.result.keyframe
+                            << " (" << event.result.error << "); going on without its planes (said once)";
+        }
+        continue;
+      }
+      const auto keyframe = KeyframeOf(event.result.keyframe);
+      event.keyframe_gone = keyframe == tracks.keyframes.end();
+      if (event.keyframe_gone) continue;
+      event.seeding = SeedDetectedPlanes(event.result.planes, keyframe->first, frame, camera, o.pdvo, o.features,
+                                         o.prior.inverse_depth_sigma / o.prior.inverse_depth,
+                                         o.prior.inverse_depth, filter.get(), &tracks);
+    }
+    if (stats->keyframe) {
+      detections->Offer({frame, timestamp, KeyframeOf(frame)->second.grey, colour.empty() ? cv::Mat() : colour.clone()});
+    }
+  }
+  std::map<int, Keyframe>::iterator KeyframeOf(int frame) {
+    return std::find_if(tracks.keyframes.begin(), tracks.keyframes.end(),
+                        [&](const auto& k) { return k.second.frame == frame; });
   }
 
   // Tracking has failed: a non-finite state, or no measurement for lost_after frames.
@@ -202,6 +241,7 @@ struct Odometry::Impl {
     }
     stats->update = update.status;
     stats->measurements = static_cast<int>(std::count(update.used.begin(), update.used.end(), true));
+    for (size_t i = 0; i < update.used.size(); ++i) stats->plane_measurements += update.used[i] && !search.matches[i].ray.isZero();
     frames_without_measurements = stats->measurements == 0 ? frames_without_measurements + 1 : 0;
   }
 
@@ -248,6 +288,7 @@ struct Odometry::Impl {
     Keyframe& keyframe = tracks.keyframes[reference];
     keyframe.grey = grey.clone();
     keyframe.time = timestamp;
+    keyframe.frame = static_cast<int>(trajectory.size());
     for (const cv::Point2f& c : found) keyframe.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
     const std::vector<PlaneSeed> seeds = seeder ? seeder->Seed(keyframe, camera) : std::vector<PlaneSeed>();
     for (const PlaneSeed& seed : seeds) {
@@ -270,8 +311,12 @@ struct Odometry::Impl {
   }
 };
 
-Odometry::Odometry(const Camera& camera, const VoOptions& options, std::unique_ptr<PlaneSeeder> seeder) {
+Odometry::Odometry(const Camera& camera, const VoOptions& options, std::unique_ptr<PlaneSeeder> seeder,
+                   PlaneDetector detector) {
   CheckOptionsOrThrow(options, "vo options");
+  PDVO_THROW_CHECK((options.mode == PlaneMode::kPdvo) == static_cast<bool>(detector), InvalidArgument,
+                   "odometry: mode " << OptionName(options.mode)
+                                     << (detector ? " takes no plane detector" : " needs a plane detector"));
   camera.Check("odometry camera");
   PDVO_THROW_CHECK(!camera.HasDistortion(), InvalidArgument,
                    "odometry: the camera has distortion; frames must be undistorted (FramePreparer)");
@@ -279,12 +324,12 @@ Odometry::Odometry(const Camera& camera, const VoOptions& options, std::unique_p
                    InvalidArgument,
                    "odometry: a " << camera.width << "x" << camera.height << " camera leaves no pixels inside the "
                                   << options.features.border << " px border");
-  impl_ = std::make_unique<Impl>(camera, options, std::move(seeder));
+  impl_ = std::make_unique<Impl>(camera, options, std::move(seeder), std::move(detector));
 }
 
 Odometry::~Odometry() = default;
 
-FrameStats Odometry::Track(const cv::Mat& grey, double timestamp) {
+FrameStats Odometry::Track(const cv::Mat& grey, double timestamp, const cv::Mat& colour) {
   const Camera& c = impl_->camera;
   PDVO_THROW_CHECK(!grey.empty() && grey.type() == CV_8UC1, InvalidArgument, "odometry: frames must be 8-bit grey");
   PDVO_THROW_CHECK(grey.cols == c.width && grey.rows == c.height, InvalidArgument,
@@ -294,8 +339,11 @@ FrameStats Odometry::Track(const cv::Mat& grey, double timestamp) {
   PDVO_THROW_CHECK(!impl_->started || timestamp > impl_->last_time, InvalidArgument,
                    "odometry: timestamps must increase (" << impl_->last_time << " then " << timestamp << ")");
   const auto start = std::chrono::steady_clock::now();
-  FrameStats stats = impl_->Track(grey, timestamp);
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  PDVO_THROW_CHECK(colour.empty() || (colour.type() == CV_8UC3 && colour.size() == grey.size()), InvalidArgument,
+                   "odometry: the colour frame must be 8-bit BGR of the grey frame's size");
+  FrameStats stats = impl_->Track(grey, timestamp, colour);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
+                  stats.detector_wait_seconds;
   return stats;
 }
 
@@ -311,6 +359,11 @@ Map Odometry::map() const {
 }
 
 const std::vector<Observation>& Odometry::observations() const { return impl_->observations; }
+
+Odometry::DetectionCounts Odometry::detection_counts() const {
+  if (!impl_->detections) return {};
+  return {impl_->detections->skipped(), impl_->detections->timed_out(), impl_->detections_failed};
+}
 
 const Trajectory& Odometry::trajectory() const { return impl_->trajectory; }
 

@@ -1,6 +1,7 @@
 #include "pdvo/vo/tracks.h"
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/options.h"
 #include "pdvo/vo/map.h"
@@ -15,6 +16,10 @@ bool FeatureOptions::Check() const {
 
 bool Inside(const Eigen::Vector2d& p, const cv::Size& size, int border) {
   return p.x() >= border && p.y() >= border && p.x() < size.width - border && p.y() < size.height - border;
+}
+
+bool InsidePolygon(const std::vector<cv::Point2f>& polygon, const Eigen::Vector2d& p, double margin) {
+  return cv::pointPolygonTest(polygon, cv::Point2f(p.x(), p.y()), margin > 0) >= margin;
 }
 
 cv::Mat InsideMask(const cv::Size& size, int border) {

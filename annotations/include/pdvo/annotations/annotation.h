@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pdvo/common/camera.h"
+#include "pdvo/common/detected_plane.h"
 
 namespace pdvo {
 
@@ -76,5 +77,9 @@ bool PolygonSelfIntersects(const std::vector<Eigen::Vector2d>& polygon);
 
 // Area of a simple polygon (shoelace), in square pixels.
 double PolygonArea(const std::vector<Eigen::Vector2d>& polygon);
+
+// The annotation's planes with a normal as detections in an image `width` px wide (the annotation's pixels
+// scaled by width / image_width; their score, 1 if none). Non-planes, and planes without a normal, are left out.
+std::vector<DetectedPlane> DetectedPlanes(const Annotation& annotation, int width);
 
 }  // namespace pdvo

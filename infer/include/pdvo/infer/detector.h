@@ -120,6 +120,9 @@ struct Detections {
   // size): the plane segments as `plane` shapes with their normal and score, the non-planes as `non-plane`.
   Annotation ToAnnotation(const std::string& image_path, int width, int height,
                           const std::optional<Camera>& camera = std::nullopt) const;
+  // The planes as the odometry takes them, in pixels of the original image (`width` x `height`): the polygons of
+  // ToAnnotation, each with the planar salient points inside it.
+  std::vector<DetectedPlane> Planes(int width, int height) const;
 };
 
 class Detector {

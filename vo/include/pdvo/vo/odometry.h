@@ -4,7 +4,9 @@
 // update the filter through 1-point RANSAC (robust_update.h); features missed or rejected too often leave;
 // planes grow (plane_growing.h). When too few features are in view, a keyframe is made: a plane seeder picks
 // where planes start (plane_seeder.h: none in mode points, where corners are densest in mode idpp) and new points
-// start at its strongest other corners. The first frames also run the two-view bootstrap (bootstrap.h). If
+// start at its strongest other corners. In mode pdvo a detector looks for planes in keyframes in the background
+// (detection_worker.h) and its planes, when they arrive, are seeded in their keyframe (plane_priors.h); no other
+// planes are made. The first frames also run the two-view bootstrap (bootstrap.h). If
 // tracking fails (no measurement for lost_after frames, or a non-finite state) the frame says so and the
 // odometry starts again from the last pose. What left the filter is kept in the map (map.h).
 //
@@ -20,10 +22,12 @@
 #include "pdvo/common/camera.h"
 #include "pdvo/common/trajectory.h"
 #include "pdvo/vo/bootstrap.h"
+#include "pdvo/vo/detection_worker.h"
 #include "pdvo/vo/filter.h"
 #include "pdvo/vo/map.h"
 #include "pdvo/vo/patch.h"
 #include "pdvo/vo/plane_growing.h"
+#include "pdvo/vo/plane_priors.h"
 #include "pdvo/vo/plane_seeder.h"
 #include "pdvo/vo/robust_update.h"
 #include "pdvo/vo/tracks.h"
@@ -65,6 +69,7 @@ struct VoOptions {
   BootstrapOptions bootstrap;
   MotionNoise motion;
   PlaneOptions planes;
+  PdvoOptions pdvo;  // mode pdvo: the detector's schedule and how its planes are seeded
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -79,19 +84,29 @@ struct VoOptions {
     visit("bootstrap", self.bootstrap);
     visit("motion", self.motion);
     visit("planes", self.planes);
+    visit("pdvo", self.pdvo);
   }
   bool Check() const;
   bool operator==(const VoOptions&) const = default;
 };
 
+// A keyframe's detections as they reached the odometry (mode pdvo).
+struct DetectionEvent {
+  DetectionResult result;  // with the planes as detected
+  bool keyframe_gone = false;  // its reference camera had left the filter: dropped
+  SeedingOutcome seeding;
+};
+
 struct FrameStats {
   double timestamp = 0;
-  double seconds = 0;       // processing time
+  double seconds = 0;       // processing time, without detector_wait_seconds
+  double detector_wait_seconds = 0;  // mode pdvo, deterministic schedule: time spent waiting for the detector
   int attempted = 0;        // features searched for
   int measurements = 0;     // matched and used in the update
   int points = 0;           // in the filter after the frame
   int planes = 0;
   int plane_points = 0;     // points held by those planes
+  int plane_measurements = 0;  // measurements of plane points used in the update
   int state_size = 0;
   bool keyframe = false;
   bool lost = false;        // tracking failed at this frame and started again
@@ -99,6 +114,7 @@ struct FrameStats {
   // The frame's update: kOk, kNoMeasurements (nothing matched, or no hypothesis had an inlier), or a failure
   // (the update was skipped and the filter left as predicted).
   UpdateStatus update = UpdateStatus::kNoMeasurements;
+  std::vector<DetectionEvent> detections;  // mode pdvo: those that arrived at this frame
 };
 
 // A feature as the last frame saw it: where it was found (or predicted, if the search failed), and where it
@@ -116,12 +132,16 @@ class Odometry {
  public:
   // `camera`: the working camera (no distortion) of the frames given to Track; throws InvalidArgument for a
   // camera with distortion or invalid options. `seeder` overrides where planes come from (default: the mode's).
-  Odometry(const Camera& camera, const VoOptions& options, std::unique_ptr<PlaneSeeder> seeder = nullptr);
+  // `detector`: mode pdvo's source of planes (required in that mode, refused in the others), run on keyframes
+  // in a thread of its own (detection_worker.h).
+  Odometry(const Camera& camera, const VoOptions& options, std::unique_ptr<PlaneSeeder> seeder = nullptr,
+           PlaneDetector detector = {});
   ~Odometry();
 
-  // One 8-bit grey frame of the camera's size; timestamps (s) must increase. Throws InvalidArgument for a
-  // frame of another size or type or a timestamp that does not increase; a failure of tracking is a value.
-  FrameStats Track(const cv::Mat& grey, double timestamp);
+  // One 8-bit grey frame of the camera's size; timestamps (s) must increase. `colour` (optional, CV_8UC3 of the
+  // same size): the same frame in colour, for the detector. Throws InvalidArgument for a frame of another size
+  // or type or a timestamp that does not increase; a failure of tracking is a value.
+  FrameStats Track(const cv::Mat& grey, double timestamp, const cv::Mat& colour = cv::Mat());
   // The pose of the last frame.
   Rigid3d world_from_cam() const;
   // The pose of every frame so far. Those of the frames before the two-view bootstrap are revised when it
@@ -133,6 +153,12 @@ class Odometry {
   Map map() const;
   // The features searched for in the last frame.
   const std::vector<Observation>& observations() const;
+  // Mode pdvo: keyframes not detected (a newer one replaced them while the detector was busy), detections
+  // given up (deterministic timeout), and detections whose detector threw.
+  struct DetectionCounts {
+    int skipped = 0, timed_out = 0, failed = 0;
+  };
+  DetectionCounts detection_counts() const;
 
  private:
   struct Impl;

@@ -68,7 +68,7 @@ class PlaneGrower {
 
  private:
   // Up to new_plane_points candidates for plane `id` from its keyframe's unused corners within grow_radius of
-  // a member and at least min_distance from all of them.
+  // a member (a detected plane: up to its new_points, inside its region) and at least min_distance from all.
   void AddCandidates(int id, Filter* filter, Tracks* tracks) const;
 
   Camera camera_;

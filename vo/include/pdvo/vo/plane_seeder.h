@@ -17,10 +17,11 @@
 
 namespace pdvo::vo {
 
-// points: inverse-depth points only; idpp: and planes seeded where corners are densest (DensestCornersSeeder).
-enum class PlaneMode { kPoints, kIdpp };
-constexpr std::array<std::pair<PlaneMode, const char*>, 2> OptionNames(PlaneMode) {
-  return {{{PlaneMode::kPoints, "points"}, {PlaneMode::kIdpp, "idpp"}}};
+// points: inverse-depth points only; idpp: and planes seeded where corners are densest (DensestCornersSeeder);
+// pdvo: and planes where a detector found them in keyframes (plane_priors.h), no others.
+enum class PlaneMode { kPoints, kIdpp, kPdvo };
+constexpr std::array<std::pair<PlaneMode, const char*>, 3> OptionNames(PlaneMode) {
+  return {{{PlaneMode::kPoints, "points"}, {PlaneMode::kIdpp, "idpp"}, {PlaneMode::kPdvo, "pdvo"}}};
 }
 
 struct PlaneSeed {
@@ -48,7 +49,7 @@ class DensestCornersSeeder : public PlaneSeeder {
   PlaneOptions o_;
 };
 
-// The seeder of a mode: none for points, DensestCornersSeeder for idpp.
+// The seeder of a mode: DensestCornersSeeder for idpp, none for points and pdvo.
 std::unique_ptr<PlaneSeeder> MakePlaneSeeder(PlaneMode mode, const PlaneOptions& options);
 
 }  // namespace pdvo::vo

@@ -52,6 +52,9 @@ cv::Mat InsideMask(const cv::Size& size, int border);
 // Corners are found by goodFeaturesToTrack with this quality level (a share of the strongest corner's score).
 inline constexpr double kCornerQuality = 0.01;
 
+// True if `pixel` lies inside `polygon` at least `margin` px from its outline.
+bool InsidePolygon(const std::vector<cv::Point2f>& polygon, const Eigen::Vector2d& pixel, double margin = 0);
+
 // A new feature's inverse-depth prior at a pixel of the current frame (1/m, in the map's scale).
 struct DepthPrior {
   Eigen::Vector2d pixel;
@@ -66,6 +69,7 @@ struct Corner {
 struct Keyframe {
   cv::Mat grey;  // the keyframe's working image: features' patches are warped from it
   double time = 0;
+  int frame = -1;  // its index in the frames tracked
   std::vector<Corner> corners;
 };
 
@@ -94,6 +98,13 @@ struct PlaneTrack {
   std::vector<PlanePoint> members;  // members[0] is the seed
   std::vector<Candidate> candidates;
   int age = 0;  // frames since the plane was made
+  // A detected plane's outline (keyframe pixels): it grows from the keyframe's corners inside it only (at least
+  // region_margin from the outline), by up to
+  // new_points candidates a frame. Empty (a blind seed): from corners within grow_radius of its members, by the
+  // options' new_plane_points.
+  std::vector<cv::Point2f> region;
+  double region_margin = 0;  // px: corners nearer the outline are not taken
+  int new_points = 0;
 };
 
 // The features of one filter, by the filter's ids, and the keyframes they come from. Every point and plane of

@@ -1,0 +1,82 @@
+#include "plane_sources.h"
+
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <vector>
+
+#include "pdvo/annotations/annotation.h"
+#include "pdvo/common/errors.h"
+#include "pdvo/infer/detector.h"
+#include "tool.h"
+
+namespace pdvo::apps {
+
+namespace fs = std::filesystem;
+
+struct PlaneSource::Impl {
+  Camera working;
+  std::string description;
+  std::unique_ptr<Detector> detector;                      // model
+  std::map<std::string, std::vector<DetectedPlane>> files;  // folder, oracle: by image stem
+  std::mutex mutex;                                         // guards names
+  std::vector<std::string> names;                           // by frame: image stems
+
+  void ReadFolder(const std::string& folder) {
+    for (const std::string& path : ListAnnotationFiles({folder})) {
+      const Annotation a = ReadAnnotation(path);
+      const std::string stem = fs::path(a.image_path.empty() ? path : a.image_path).stem().string();
+      files[stem] = DetectedPlanes(a, working.width);
+    }
+  }
+};
+
+PlaneSource::PlaneSource(const std::string& source, const std::string& model_path, const std::string& sequence_path,
+                         const Camera& working)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->working = working;
+  if (source == "model") {
+    impl_->detector = std::make_unique<Detector>(PlaneModel::Read(model_path), DetectorOptions());
+    impl_->description = "the detector with " + model_path;
+  } else if (source == "oracle") {
+    const fs::path folder = fs::path(sequence_path) / "annotations";
+    PDVO_THROW_CHECK(fs::is_directory(folder), IoError,
+                     sequence_path << ": --detections oracle needs the sequence's annotations/ (pdvo synth output)");
+    impl_->ReadFolder(folder.string());
+    impl_->description = "the oracle (" + folder.string() + ")";
+  } else {
+    impl_->ReadFolder(source);
+    impl_->description = "the annotations in " + source;
+  }
+}
+
+PlaneSource::~PlaneSource() = default;
+
+void PlaneSource::AddFrame(int index, const std::string& image_path) {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  if (static_cast<int>(impl_->names.size()) <= index) impl_->names.resize(index + 1);
+  impl_->names[index] = fs::path(image_path).stem().string();
+}
+
+vo::PlaneDetector PlaneSource::detector() {
+  Impl* impl = impl_.get();
+  if (impl->detector) {
+    return [impl](const vo::KeyframeImage& k) {
+      const cv::Mat& image = k.colour.empty() ? k.grey : k.colour;
+      return impl->detector->Detect(image, impl->working).Planes(image.cols, image.rows);
+    };
+  }
+  return [impl](const vo::KeyframeImage& k) {
+    std::string name;
+    {
+      std::lock_guard<std::mutex> lock(impl->mutex);
+      if (k.frame < static_cast<int>(impl->names.size())) name = impl->names[k.frame];
+    }
+    const auto found = impl->files.find(name);
+    return found == impl->files.end() ? std::vector<DetectedPlane>() : found->second;
+  };
+}
+
+std::string PlaneSource::Describe() const { return impl_->description; }
+
+}  // namespace pdvo::apps

@@ -1,0 +1,206 @@
+// Detected planes as priors, on a wall of known depth: a detection is seeded at the corner nearest its centroid
+// with the detected normal as its prior and the inverse distance its keyframe's points say; the paper's 30 px
+// rule, the small, mapped, grazing and invalid cases are refused and counted; the plane grows only from corners
+// inside its polygon, at most new_plane_points a frame; a detection reaches an older keyframe than the newest.
+#include "pdvo/vo/plane_priors.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pdvo/vo/map.h"
+#include "pdvo/vo/plane_growing.h"
+
+namespace pdvo::vo {
+namespace {
+
+const Camera kCamera = Camera::Pinhole(320, 240, 277, 277, 159.5, 119.5);
+
+// A keyframe (reference camera at the origin) looking at a textured wall 5 m ahead, its corners found, and
+// points of the filter at some of them at the wall's inverse depth.
+struct Scene {
+  Filter filter{CameraState(), Matrix12d::Identity() * 1e-8};
+  Tracks tracks;
+  int reference = -1;
+  FeatureOptions features;
+  PdvoOptions options;
+
+  Scene() {
+    reference = filter.AddReference(true);
+    Keyframe& k = tracks.keyframes[reference];
+    k.frame = 10;
+    k.grey = cv::Mat(240, 320, CV_8U);
+    cv::RNG rng(7);
+    rng.fill(k.grey, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(k.grey, k.grey, cv::Size(5, 5), 1.5);
+    std::vector<cv::Point2f> found;
+    cv::goodFeaturesToTrack(k.grey, found, 100, kCornerQuality, features.min_distance, InsideMask(k.grey.size(), 10));
+    for (const cv::Point2f& c : found) k.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
+  }
+  // A point at the wall (5 m) at the keyframe's corner `i`.
+  int PointAt(int i) {
+    Corner& c = tracks.keyframes.at(reference).corners.at(i);
+    c.used = true;
+    const Eigen::Vector3d ray = kCamera.Ray(c.pixel);
+    const int id = filter.AddPoint(reference, ray, ray.z() / 5.0, 0.01);
+    tracks.points[id] = {c.pixel, {}};
+    return id;
+  }
+  SeedingOutcome Seed(const std::vector<DetectedPlane>& planes, int frame = 14) {
+    return SeedDetectedPlanes(planes, reference, frame, kCamera, options, features, 1.0, 0.2, &filter, &tracks);
+  }
+};
+
+DetectedPlane Box(double x0, double y0, double x1, double y1, const Eigen::Vector3d& normal) {
+  DetectedPlane p;
+  p.polygon = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  p.normal = normal;
+  return p;
+}
+
+const Eigen::Vector3d kFacing(0, 0, -1);  // the wall's normal, towards the camera
+
+TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
+  Scene s;
+  for (int i = 0; i < 30; ++i) s.PointAt(i);  // the strongest corners are points already
+  const Eigen::Vector3d tilted = Eigen::Vector3d(0.2, -0.1, -1).normalized();
+  const DetectedPlane wall = Box(60, 40, 260, 200, Eigen::Vector3d(0.4, -0.2, -2));  // not unit: normalised
+  const SeedingOutcome o = s.Seed({wall});
+  EXPECT_EQ(o.detected, 1);
+  ASSERT_EQ(o.seeded, 1);
+  ASSERT_EQ(s.filter.planes().size(), 1u);
+  const auto& [id, plane] = *s.filter.planes().begin();
+  EXPECT_EQ(plane.reference, s.reference);
+  EXPECT_LT((plane.plane.normal - tilted).norm(), 1e-12);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(s.filter.covariance()(plane.offset + k, plane.offset + k), s.options.normal_sigma * s.options.normal_sigma,
+                1e-12);
+  }
+  // Seeded at the unused corner inside the polygon nearest its centroid (160, 120).
+  const PlaneTrack& track = s.tracks.planes.at(id);
+  double nearest = 1e9;
+  for (const Corner& c : s.tracks.keyframes.at(s.reference).corners) {
+    if (InsidePolygon(track.region, c.pixel, s.options.region_margin) && c.pixel != track.members[0].keyframe_pixel) {
+      if (!c.used) nearest = std::min(nearest, (c.pixel - Eigen::Vector2d(160, 120)).norm());
+    }
+  }
+  EXPECT_LE((track.members[0].keyframe_pixel - Eigen::Vector2d(160, 120)).norm(), nearest);
+  // The keyframe's points inside the polygon are its first candidates, of the keyframe's age.
+  int inside = 0;
+  for (const auto& [point, t] : s.tracks.points) inside += InsidePolygon(track.region, t.keyframe_pixel, 8);
+  EXPECT_EQ(static_cast<int>(track.candidates.size()), inside);
+  for (const Candidate& c : track.candidates) EXPECT_EQ(c.age, 4);
+  EXPECT_EQ(track.new_points, s.options.new_plane_points);
+  // Its inverse distance: the median of what the points on the wall say with the detected normal,
+  // rho_p = -rho / (n . m).
+  std::vector<double> says;
+  for (const auto& [point, p] : s.filter.points()) {
+    if (InsidePolygon(track.region, s.tracks.points.at(point).keyframe_pixel)) says.push_back(-p.inverse_depth / tilted.dot(p.ray));
+  }
+  std::sort(says.begin(), says.end());
+  ASSERT_GE(says.size(), 3u);
+  EXPECT_NEAR(plane.plane.inverse_distance, says[says.size() / 2], 1e-12);
+}
+
+TEST(PlanePriors, WithoutPointsTheInverseDistanceComesFromThePrior) {
+  Scene s;
+  ASSERT_EQ(s.Seed({Box(60, 40, 260, 200, kFacing)}).seeded, 1);
+  const Filter::Plane& plane = s.filter.planes().begin()->second;
+  const Eigen::Vector3d ray = s.tracks.planes.begin()->second.members[0].ray;
+  EXPECT_NEAR(plane.plane.InverseDepthAlong(ray), 0.2, 1e-12);  // the default inverse depth at the seed
+}
+
+TEST(PlanePriors, TheThirtyPixelRule) {
+  for (const double offset : {29.0, 31.0}) {
+    Scene s;
+    // A plane of the keyframe with a member `offset` px from the detection's centroid (160, 120).
+    const int id = s.filter.AddPlane(s.reference, {kFacing, 0.2}, 0.1, 0.01);
+    const Eigen::Vector2d pixel(160 + offset, 120);
+    s.tracks.planes[id].members.push_back({pixel, kCamera.Ray(pixel), {}});
+    const SeedingOutcome o = s.Seed({Box(100, 60, 220, 180, kFacing)});
+    EXPECT_EQ(o.near_plane, offset < 30 ? 1 : 0) << offset;
+    EXPECT_EQ(o.seeded, offset < 30 ? 0 : 1) << offset;
+  }
+}
+
+TEST(PlanePriors, PlanarPointsOfAnotherKeyframeCountWhereTheKeyframeSeesThem) {
+  Scene s;
+  // A newer keyframe 1 m to the right holds a plane on the same wall; its member at its own pixel (160, 120)
+  // is where the older keyframe sees the wall point 1 m right of its centre.
+  CameraState moved;
+  moved.position = Eigen::Vector3d(1, 0, 0);
+  Filter& f = s.filter;
+  f.Apply([&] {
+    Eigen::VectorXd d = Eigen::VectorXd::Zero(f.size());
+    d.head<3>() = moved.position;
+    return d;
+  }());
+  const int newer = f.AddReference(true);
+  const int id = f.AddPlane(newer, {kFacing, 0.2}, 0.1, 0.01);
+  s.tracks.planes[id].members.push_back({{160, 120}, kCamera.Ray({160, 120}), {}});
+  const std::vector<Eigen::Vector2d> seen = PlanarPixelsInKeyframe(f, s.tracks, s.reference, kCamera);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_LT((seen[0] - Eigen::Vector2d(160 + 277 / 5.0, 120)).norm(), 1e-6);
+  // A detection of the older keyframe centred there is refused; the same one elsewhere is seeded in the older
+  // keyframe, not the newer one.
+  EXPECT_EQ(s.Seed({Box(160, 60, 270, 180, kFacing)}).near_plane, 1);
+  EXPECT_EQ(s.Seed({Box(20, 60, 130, 180, kFacing)}).seeded, 1);
+  int in_older = 0;
+  for (const auto& [pid, p] : f.planes()) in_older += p.reference == s.reference;
+  EXPECT_EQ(in_older, 1);
+}
+
+TEST(PlanePriors, RefusedDetectionsAreCounted) {
+  Scene s;
+  DetectedPlane invalid = Box(60, 40, 260, 200, kFacing);
+  invalid.normal = Eigen::Vector3d(NAN, 0, -1);
+  DetectedPlane line = Box(60, 40, 260, 200, kFacing);
+  line.polygon.resize(2);
+  const Eigen::Vector3d edge_on = Eigen::Vector3d(1, 0, -0.05).normalized();  // along the rays
+  const SeedingOutcome o =
+      s.Seed({invalid, line, Box(10, 10, 40, 40, kFacing), Box(60, 40, 260, 200, edge_on), Box(60, 40, 260, 200, -kFacing)});
+  EXPECT_EQ(o.detected, 5);
+  EXPECT_EQ(o.invalid, 2);
+  EXPECT_EQ(o.small, 1);   // 900 px^2 < min_area
+  EXPECT_EQ(o.grazing, 2);  // edge-on, and facing away
+  EXPECT_EQ(o.seeded, 0);
+  EXPECT_TRUE(s.filter.planes().empty());
+  // A second detection of a wall that is mapped already (planar points inside its polygon) is refused.
+  ASSERT_EQ(s.Seed({Box(60, 40, 260, 200, kFacing)}).seeded, 1);
+  PlaneTrack& t = s.tracks.planes.begin()->second;
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(70, 50), Eigen::Vector2d(100, 50), Eigen::Vector2d(70, 190)}) {
+    t.members.push_back({p, kCamera.Ray(p), {}});
+  }
+  EXPECT_EQ(s.Seed({Box(50, 30, 130, 210, kFacing)}).mapped, 1);  // centroid (90, 120): 70 px from each
+}
+
+TEST(PlanePriors, GrowthStaysInsideThePolygon) {
+  Scene s;
+  ASSERT_EQ(s.Seed({Box(40, 40, 150, 200, kFacing)}).seeded, 1);
+  const int id = s.tracks.planes.begin()->first;
+  PlaneOptions planes;
+  const PlaneGrower grower(kCamera, planes, s.features, 1.0);
+  MapRecord record(planes.min_plane_points);
+  size_t before = s.filter.points().size();
+  for (int frame = 0; frame < 3; ++frame) {
+    grower.Grow(&s.filter, &s.tracks, &record);
+    const size_t added = s.filter.points().size() - before;
+    EXPECT_LE(static_cast<int>(added), s.options.new_plane_points);
+    before = s.filter.points().size();
+  }
+  const PlaneTrack& track = s.tracks.planes.at(id);
+  ASSERT_FALSE(track.candidates.empty());
+  for (const Candidate& c : track.candidates) {
+    const Eigen::Vector2d& p = s.tracks.points.at(c.point).keyframe_pixel;
+    EXPECT_TRUE(InsidePolygon(track.region, p, s.options.region_margin)) << p.transpose();
+  }
+  // Corners outside the polygon were left for points.
+  int outside_used = 0;
+  for (const Corner& c : s.tracks.keyframes.at(s.reference).corners) {
+    outside_used += c.used && !InsidePolygon(track.region, c.pixel);
+  }
+  EXPECT_EQ(outside_used, 0);
+}
+
+}  // namespace
+}  // namespace pdvo::vo
