@@ -5,10 +5,12 @@
 # excerpts in ../shared/data (TUM fr1/rpy, KITTI 06) through `pdvo vo` and `pdvo ate`. Prints the tables and
 # writes OUT/results.txt (one line per run), OUT/fig4_plane_measurements.svg (a plane's measurements by frames
 # since its keyframe, mean over planes and streets) and OUT/fig10_fps.svg (the tracking thread's frames per
-# second along the streets, mean over streets). Speeds are the tracking thread's CPU time, one core per run.
+# second along the streets, mean over streets). Speeds are the tracking thread's CPU time. Runs kept in OUT/runs
+# are not run again: remove OUT to start afresh.
 #
 # Usage: bench/pdvo_compare.sh [OUT] [SEEDS]   default OUT out/pdvo_compare, SEEDS "1 2 3 101 ... 124" (the
-#        benchmark streets and 24 streets never used for tuning; seeds 31-42 are the tuning streets)
+#        benchmark streets and 24 streets never used for tuning: the odometry was tuned on 31-54, the pdvo
+#        options chosen on 31-36)
 set -euo pipefail
 out=${1:-out/pdvo_compare}
 seeds=${2:-"1 2 3 $(seq -s ' ' 101 124)"}
@@ -20,27 +22,18 @@ data=${PDVO_DATA:-../shared/data}
 mkdir -p "$out/runs"
 configs=("idpp:mode=idpp" "pdvo:mode=pdvo source=model" "oracle:mode=pdvo source=oracle")
 
-run_core() {  # core, then seed:config pairs
-  local core=$1 job seed name args
-  shift
-  for job in "$@"; do
-    seed=${job%%:*} name=${job#*:}
-    for c in "${configs[@]}"; do [ "${c%%:*}" = "$name" ] && args=${c#*:}; done
-    local log="$out/runs/${name}_$seed.txt"
+# One run at a time, the configurations of a street one after the other: a pdvo run's detector thread has the
+# second core, as it would beside a camera, and the machine's load changes alike for the three.
+echo "pdvo_compare: $(($(wc -w <<<"$seeds") * ${#configs[@]})) runs of $frames frames on streets $seeds"
+for seed in $seeds; do
+  for c in "${configs[@]}"; do
+    log="$out/runs/${c%%:*}_$seed.txt"
     [ -s "$log" ] && grep -q '^result ' "$log" && continue  # kept from an earlier run of the script
     # shellcheck disable=SC2086
-    taskset -c "$core" "$bench" "$frames" "$seed" $args >"$log.tmp" 2>&1 || { cat "$log.tmp" >&2; exit 1; }
+    "$bench" "$frames" "$seed" ${c#*:} >"$log.tmp" 2>&1 || { cat "$log.tmp" >&2; exit 1; }
     mv "$log.tmp" "$log"
   done
-}
-jobs=()
-for seed in $seeds; do for c in "${configs[@]}"; do jobs+=("$seed:${c%%:*}"); done; done
-even=() odd=()
-for i in "${!jobs[@]}"; do if ((i % 2)); then odd+=("${jobs[$i]}"); else even+=("${jobs[$i]}"); fi; done
-echo "pdvo_compare: ${#jobs[@]} runs of $frames frames on streets $seeds (two at a time)"
-run_core 0 "${even[@]}" &
-run_core 1 "${odd[@]}"
-wait
+done
 for seed in $seeds; do for c in "${configs[@]}"; do
   grep '^result ' "$out/runs/${c%%:*}_$seed.txt" | sed "s/^result /result name=${c%%:*} /"
 done; done >"$out/results.txt"

@@ -65,6 +65,7 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   for (int i = 0; i < 30; ++i) s.PointAt(i);  // the strongest corners are points already
   const Eigen::Vector3d tilted = Eigen::Vector3d(0.2, -0.1, -1).normalized();
   const DetectedPlane wall = Box(60, 40, 260, 200, Eigen::Vector3d(0.4, -0.2, -2));  // not unit: normalised
+  const std::vector<cv::Point2f> outline = {{60, 40}, {260, 40}, {260, 200}, {60, 200}};
   const SeedingOutcome o = s.Seed({wall});
   EXPECT_EQ(o.detected, 1);
   ASSERT_EQ(o.seeded, 1);
@@ -80,14 +81,14 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   const PlaneTrack& track = s.tracks.planes.at(id);
   double nearest = 1e9;
   for (const Corner& c : s.tracks.keyframes.at(s.reference).corners) {
-    if (InsidePolygon(track.region, c.pixel, s.options.region_margin) && c.pixel != track.members[0].keyframe_pixel) {
+    if (InsidePolygon(outline, c.pixel, s.options.region_margin) && c.pixel != track.members[0].keyframe_pixel) {
       if (!c.used) nearest = std::min(nearest, (c.pixel - Eigen::Vector2d(160, 120)).norm());
     }
   }
   EXPECT_LE((track.members[0].keyframe_pixel - Eigen::Vector2d(160, 120)).norm(), nearest);
   // The keyframe's points inside the polygon are its first candidates, of the keyframe's age.
   int inside = 0;
-  for (const auto& [point, t] : s.tracks.points) inside += InsidePolygon(track.region, t.keyframe_pixel, 8);
+  for (const auto& [point, t] : s.tracks.points) inside += InsidePolygon(outline, t.keyframe_pixel, 8);
   EXPECT_EQ(static_cast<int>(track.candidates.size()), inside);
   for (const Candidate& c : track.candidates) EXPECT_EQ(c.age, 4);
   EXPECT_EQ(track.new_points, s.options.new_plane_points);
@@ -95,7 +96,7 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   // rho_p = -rho / (n . m).
   std::vector<double> says;
   for (const auto& [point, p] : s.filter.points()) {
-    if (InsidePolygon(track.region, s.tracks.points.at(point).keyframe_pixel)) says.push_back(-p.inverse_depth / tilted.dot(p.ray));
+    if (InsidePolygon(outline, s.tracks.points.at(point).keyframe_pixel)) says.push_back(-p.inverse_depth / tilted.dot(p.ray));
   }
   std::sort(says.begin(), says.end());
   ASSERT_GE(says.size(), 3u);
@@ -177,6 +178,7 @@ TEST(PlanePriors, RefusedDetectionsAreCounted) {
 TEST(PlanePriors, GrowthStaysInsideThePolygon) {
   Scene s;
   ASSERT_EQ(s.Seed({Box(40, 40, 150, 200, kFacing)}).seeded, 1);
+  const std::vector<cv::Point2f> outline = {{40, 40}, {150, 40}, {150, 200}, {40, 200}};
   const int id = s.tracks.planes.begin()->first;
   PlaneOptions planes;
   const PlaneGrower grower(kCamera, planes, s.features, 1.0);
@@ -192,12 +194,12 @@ TEST(PlanePriors, GrowthStaysInsideThePolygon) {
   ASSERT_FALSE(track.candidates.empty());
   for (const Candidate& c : track.candidates) {
     const Eigen::Vector2d& p = s.tracks.points.at(c.point).keyframe_pixel;
-    EXPECT_TRUE(InsidePolygon(track.region, p, s.options.region_margin)) << p.transpose();
+    EXPECT_TRUE(InsidePolygon(outline, p, s.options.region_margin)) << p.transpose();
   }
   // Corners outside the polygon were left for points.
   int outside_used = 0;
   for (const Corner& c : s.tracks.keyframes.at(s.reference).corners) {
-    outside_used += c.used && !InsidePolygon(track.region, c.pixel);
+    outside_used += c.used && !InsidePolygon(outline, c.pixel);
   }
   EXPECT_EQ(outside_used, 0);
 }

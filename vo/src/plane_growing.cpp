@@ -83,17 +83,16 @@ void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const 
 void PlaneGrower::AddCandidates(int id, Filter* filter, Tracks* tracks) const {
   const Filter::Plane& plane = filter->planes().at(id);
   PlaneTrack& t = tracks->planes.at(id);
-  const int wanted = t.region.empty() ? o_.new_plane_points : t.new_points;
+  std::vector<Corner>& corners = tracks->keyframes.at(plane.reference).corners;
+  const int wanted = t.detected ? t.new_points : o_.new_plane_points;
+  const size_t count = t.detected ? t.region_corners.size() : corners.size();
   int added = 0;
-  for (Corner& corner : tracks->keyframes.at(plane.reference).corners) {
-    if (added >= wanted) break;
+  for (size_t i = 0; i < count && added < wanted; ++i) {
+    Corner& corner = corners.at(t.detected ? t.region_corners[i] : i);
     if (corner.used) continue;
     double nearest = 1e9;
     for (const PlanePoint& m : t.members) nearest = std::min(nearest, (m.keyframe_pixel - corner.pixel).norm());
-    const bool near = t.region.empty()
-                          ? nearest <= o_.grow_radius
-                          : InsidePolygon(t.region, corner.pixel, t.region_margin);
-    if (!near || nearest < features_.min_distance) continue;
+    if ((!t.detected && nearest > o_.grow_radius) || nearest < features_.min_distance) continue;
     const Eigen::Vector3d ray = camera_.Ray(corner.pixel);
     const double rho = plane.plane.InverseDepthAlong(ray);
     if (rho <= 0) continue;

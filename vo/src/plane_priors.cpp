@@ -59,10 +59,12 @@ void AddRegionCorners(const std::vector<cv::Point2f>& polygon, int count, const 
     cv::circle(region, cv::Point(cvRound(c.pixel.x()), cvRound(c.pixel.y())), static_cast<int>(features.min_distance),
                cv::Scalar(0), cv::FILLED);
   }
-  if (cv::countNonZero(region) == 0) return;
+  // Within the polygon's bounding box (with the corner detector's window of margin) only: a tenth of the cost.
+  const cv::Rect box = (cv::boundingRect(outline) + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(cv::Point(), region.size());
+  if (box.empty() || cv::countNonZero(region(box)) == 0) return;
   std::vector<cv::Point2f> found;
-  cv::goodFeaturesToTrack(keyframe->grey, found, count, kCornerQuality, features.min_distance, region);
-  for (const cv::Point2f& c : found) keyframe->corners.push_back({Eigen::Vector2d(c.x, c.y), false});
+  cv::goodFeaturesToTrack(keyframe->grey(box), found, count, kCornerQuality, features.min_distance, region(box));
+  for (const cv::Point2f& c : found) keyframe->corners.push_back({Eigen::Vector2d(c.x + box.x, c.y + box.y), false});
 }
 
 // The plane's inverse distance (keyframe frame) with unit normal n: from the keyframe's points inside the
@@ -150,10 +152,13 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       continue;
     }
     AddRegionCorners(polygon, o.region_corners, features, &keyframe);
+    std::vector<int> region;  // the keyframe's corners inside the polygon
     Corner* seed = nullptr;
-    for (Corner& c : keyframe.corners) {
-      if (c.used || !InsidePolygon(polygon, c.pixel, o.region_margin)) continue;
-      if (!seed || (c.pixel - centroid).squaredNorm() < (seed->pixel - centroid).squaredNorm()) seed = &c;
+    for (size_t i = 0; i < keyframe.corners.size(); ++i) {
+      Corner& c = keyframe.corners[i];
+      if (!InsidePolygon(polygon, c.pixel, o.region_margin)) continue;
+      region.push_back(static_cast<int>(i));
+      if (!c.used && (!seed || (c.pixel - centroid).squaredNorm() < (seed->pixel - centroid).squaredNorm())) seed = &c;
     }
     if (!seed) {
       ++out.no_corner;
@@ -171,8 +176,8 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
     const int id = filter->AddPlane(reference, {n, rho_p}, o.normal_sigma, relative_prior_sigma * rho_p);
     PlaneTrack& track = tracks->planes[id];
     track.members.push_back({seed->pixel, ray, {}});
-    track.region = polygon;
-    track.region_margin = o.region_margin;
+    track.detected = true;
+    track.region_corners = std::move(region);
     track.new_points = o.new_plane_points;
     // The keyframe's points inside the polygon have been tracked since the keyframe: candidates at once.
     for (const auto& [point, p] : tracks->points) {

@@ -68,7 +68,8 @@ class PlaneGrower {
 
  private:
   // Up to new_plane_points candidates for plane `id` from its keyframe's unused corners within grow_radius of
-  // a member (a detected plane: up to its new_points, inside its region) and at least min_distance from all.
+  // a member (a detected plane: up to its new_points, from its region_corners) and at least min_distance from
+  // all of them.
   void AddCandidates(int id, Filter* filter, Tracks* tracks) const;
 
   Camera camera_;

@@ -98,12 +98,11 @@ struct PlaneTrack {
   std::vector<PlanePoint> members;  // members[0] is the seed
   std::vector<Candidate> candidates;
   int age = 0;  // frames since the plane was made
-  // A detected plane's outline (keyframe pixels): it grows from the keyframe's corners inside it only (at least
-  // region_margin from the outline), by up to
-  // new_points candidates a frame. Empty (a blind seed): from corners within grow_radius of its members, by the
-  // options' new_plane_points.
-  std::vector<cv::Point2f> region;
-  double region_margin = 0;  // px: corners nearer the outline are not taken
+  // A detected plane (plane_priors.h) grows from the keyframe corners inside its outline only (indices into its
+  // keyframe's corners), by up to new_points candidates a frame. A blind seed (detected false): from the
+  // corners within grow_radius of its members, by the options' new_plane_points.
+  bool detected = false;
+  std::vector<int> region_corners;
   int new_points = 0;
 };
 
