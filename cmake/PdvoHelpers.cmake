@@ -1,11 +1,19 @@
 # pdvo_add_library(NAME <name> SRCS <files> [PUBLIC_LINK <libs>] [PRIVATE_LINK <libs>])
-# Builds pdvo_<name> from <name>/src, with public headers in <name>/include, and its tests from tests/<name>/.
+# Builds pdvo_<name> (also named pdvo::<name>, as other projects see it after find_package(pdvo)) from
+# <name>/src, with public headers in <name>/include, installed with the export set pdvoTargets; and its tests
+# from tests/<name>/.
 function(pdvo_add_library)
   cmake_parse_arguments(ARG "" "NAME" "SRCS;PUBLIC_LINK;PRIVATE_LINK" ${ARGN})
   set(target pdvo_${ARG_NAME})
   add_library(${target} STATIC ${ARG_SRCS})
-  target_include_directories(${target} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  add_library(pdvo::${ARG_NAME} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${ARG_NAME})
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+                                              $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_LINK} PRIVATE ${ARG_PRIVATE_LINK})
+  install(TARGETS ${target} EXPORT pdvoTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   # The library's tests live in tests/<name>/.
   if(PDVO_BUILD_TESTS AND EXISTS ${CMAKE_SOURCE_DIR}/tests/${ARG_NAME}/CMakeLists.txt)
     add_subdirectory(${CMAKE_SOURCE_DIR}/tests/${ARG_NAME} ${CMAKE_BINARY_DIR}/tests/${ARG_NAME})
