@@ -1,5 +1,6 @@
 #include "pdvo/common/options.h"
 
+#include <cctype>
 #include <charconv>
 #include <filesystem>
 #include <sstream>
@@ -10,6 +11,29 @@ namespace detail {
 std::string& FailedOption() {
   thread_local std::string failed;
   return failed;
+}
+
+std::string ValueText(bool value) { return value ? "true" : "false"; }
+std::string ValueText(int value) { return std::to_string(value); }
+std::string ValueText(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+std::string ValueText(const std::string& value) { return "'" + value + "'"; }
+std::string ValueText(const std::vector<double>& value) {
+  std::string out = "[";
+  for (size_t i = 0; i < value.size(); ++i) out += (i ? ", " : "") + ValueText(value[i]);
+  return out + "]";
+}
+
+bool MentionsIdentifier(const std::string& text, const std::string& name) {
+  auto part = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
+    const size_t end = at + name.size();
+    if ((at == 0 || !part(text[at - 1])) && (end == text.size() || !part(text[end]))) return true;
+  }
+  return false;
 }
 
 namespace {

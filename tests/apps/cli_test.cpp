@@ -366,7 +366,7 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
                "no non-plane regions");
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifiers=0",
-               "invalid train options: classifiers >= 1 does not hold");
+               "invalid train options: classifiers >= 1 does not hold (classifiers = 0)");
   // A missing image.
   a.image_path = "gone.png";
   fs::create_directories(dir / "missing");

@@ -95,7 +95,8 @@ TEST(Options, CheckRejectsBadValues) {
     FAIL() << "expected InvalidArgument";
   } catch (const InvalidArgument& e) {
     // One message naming the file and the innermost condition that failed, not the outer check of `inner`.
-    EXPECT_EQ(std::string(e.what()), "invalid options in " + (dir / "o.yaml") + ": iterations > 0 does not hold");
+    EXPECT_EQ(std::string(e.what()),
+              "invalid options in " + (dir / "o.yaml") + ": iterations > 0 does not hold (inner.iterations = 0)");
   }
   // The next check starts afresh: a failure of the outer options names the outer condition.
   OuterOptions o;
@@ -104,8 +105,15 @@ TEST(Options, CheckRejectsBadValues) {
     CheckOptionsOrThrow(o, "outer options");
     FAIL() << "expected InvalidArgument";
   } catch (const InvalidArgument& e) {
-    EXPECT_EQ(std::string(e.what()), "invalid outer options: threshold >= 0 does not hold");
+    EXPECT_EQ(std::string(e.what()), "invalid outer options: threshold >= 0 does not hold (threshold = -1)");
   }
+}
+
+TEST(Options, AFailedCheckNamesTheValuesOfWholeNamesOnly) {
+  EXPECT_TRUE(detail::MentionsIdentifier("iterations > 0", "iterations"));
+  EXPECT_TRUE(detail::MentionsIdentifier("a && (iterations)", "iterations"));
+  EXPECT_FALSE(detail::MentionsIdentifier("max_iterations > 0", "iterations"));
+  EXPECT_FALSE(detail::MentionsIdentifier("iterations2 > 0", "iterations"));
 }
 
 TEST(Options, MissingFileIsAnIoError) {

@@ -193,12 +193,49 @@ void ApplyOverrides(T& options, const std::vector<std::string>& assignments) {
 // Opens a YAML file for reading; throws IoError naming the file if it cannot be opened or parsed.
 cv::FileStorage OpenYamlForReading(const std::string& path);
 
-// Throws InvalidArgument if options.Check() fails, naming the options (`what`) and the failed condition.
+namespace detail {
+std::string ValueText(bool value);
+std::string ValueText(int value);
+std::string ValueText(double value);
+std::string ValueText(const std::string& value);
+std::string ValueText(const std::vector<double>& value);
+// True if `name` stands in `text` as a whole identifier.
+bool MentionsIdentifier(const std::string& text, const std::string& name);
+
+// "a.b = value" for each field whose name the condition mentions (the same name in several groups: each).
+template <OptionsStruct T>
+void MentionedValues(const T& options, const std::string& condition, const std::string& prefix,
+                     std::vector<std::string>* out) {
+  auto visit = [&](const char* key, const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (OptionsStruct<Field>) {
+      MentionedValues(field, condition, prefix + key + ".", out);
+    } else if (MentionsIdentifier(condition, key)) {
+      if constexpr (OptionsEnum<Field>) {
+        out->push_back(prefix + key + " = " + OptionName(field));
+      } else {
+        out->push_back(prefix + key + " = " + ValueText(field));
+      }
+    }
+  };
+  T::Fields(options, visit);
+}
+}  // namespace detail
+
+// Throws InvalidArgument if options.Check() fails, naming the options (`what`), the failed condition and the
+// values of the options it names, e.g. "invalid vo options: search.min_ncc > -1 && ... does not hold
+// (search.min_ncc = 1.5)".
 template <OptionsStruct T>
 void CheckOptionsOrThrow(const T& options, const std::string& what) {
   detail::FailedOption().clear();
-  PDVO_THROW_CHECK(options.Check(), InvalidArgument,
-                   "invalid " << what << ": " << detail::FailedOption() << " does not hold");
+  if (options.Check()) return;
+  const std::string condition = detail::FailedOption();
+  std::vector<std::string> values;
+  detail::MentionedValues(options, condition, "", &values);
+  std::string listed;
+  for (const std::string& v : values) listed += (listed.empty() ? " (" : ", ") + v;
+  PDVO_THROW(InvalidArgument, "invalid " << what << ": " << condition << " does not hold" << listed
+                                         << (listed.empty() ? "" : ")"));
 }
 
 // Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them.
