@@ -27,7 +27,7 @@ constexpr Command kCommands[] = {
     {"evaluate", pdvo::apps::RunEvaluate, "region recognition accuracy and normal error of a model"},
     {"detect", pdvo::apps::RunDetect, "find the planes in single images: windows, MRF segmentation, annotations"},
     {"evaluate-detection", pdvo::apps::RunEvaluateDetection, "score detections against reference annotations"},
-    {"vo", pdvo::apps::RunVo, "monocular visual odometry (EKF, inverse-depth points) over a sequence"},
+    {"vo", pdvo::apps::RunVo, "monocular visual odometry over a sequence, with detected planes as priors (PDVO)"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
 };
 
