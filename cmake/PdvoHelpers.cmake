@@ -20,10 +20,12 @@ function(pdvo_add_library)
   endif()
 endfunction()
 
-# pdvo_add_test(LIB <lib> NAME <unit> [LINK <libs>] [LABELS <labels>])
-# One gtest executable per tests/<lib>/<unit>_test.cpp, registered as "<lib>/<unit>_test".
+# pdvo_add_test(LIB <lib> NAME <unit> [LINK <libs>] [LABELS <labels>] [SLOW <gtest filter>])
+# One gtest executable per tests/<lib>/<unit>_test.cpp, registered as "<lib>/<unit>_test.*", labelled unit (or
+# LABELS); the tests that SLOW matches (end-to-end runs of many seconds) are labelled e2e instead, so that
+# `ctest -L unit` stays fast.
 function(pdvo_add_test)
-  cmake_parse_arguments(ARG "" "LIB;NAME" "LINK;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "LIB;NAME;SLOW" "LINK;LABELS" ${ARGN})
   if(NOT PDVO_BUILD_TESTS)
     return()
   endif()
@@ -34,6 +36,13 @@ function(pdvo_add_test)
   if(ARG_LABELS)
     set(labels ${ARG_LABELS})
   endif()
-  gtest_discover_tests(${target} TEST_PREFIX "${ARG_LIB}/${ARG_NAME}_test." PROPERTIES LABELS "${labels}"
-                       DISCOVERY_TIMEOUT 60)
+  set(prefix "${ARG_LIB}/${ARG_NAME}_test.")
+  if(ARG_SLOW)
+    gtest_discover_tests(${target} TEST_PREFIX "${prefix}" TEST_FILTER "-${ARG_SLOW}" PROPERTIES LABELS "${labels}"
+                         DISCOVERY_TIMEOUT 60)
+    gtest_discover_tests(${target} TEST_PREFIX "${prefix}" TEST_FILTER "${ARG_SLOW}" PROPERTIES LABELS e2e
+                         DISCOVERY_TIMEOUT 60)
+  else()
+    gtest_discover_tests(${target} TEST_PREFIX "${prefix}" PROPERTIES LABELS "${labels}" DISCOVERY_TIMEOUT 60)
+  endif()
 endfunction()

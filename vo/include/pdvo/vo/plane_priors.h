@@ -33,8 +33,8 @@ struct PdvoOptions {
   int max_planes = 10;               // planes seeded per keyframe, at most: the largest detections first
   // A detection whose polygon holds this many planar points visible in the keyframe is mapped already.
   int max_mapped_points = 3;
-  // The prior standard deviation of each component of a detected (unit) normal: about the shipped model's
-  // normal error on held-out streets (mean 5 degrees, docs/detector.md), doubled for real images.
+  // The prior standard deviation of each component of a detected (unit) normal (about 9 degrees; the shipped
+  // model's matched planes are 2-3 degrees off on held-out streets, more on real images: docs/detector.md).
   double normal_sigma = 0.15;
   int new_plane_points = 10;         // candidates a detected plane takes a frame (the paper)
   int region_corners = 60;           // new corners looked for inside each detected polygon, at most
