@@ -15,11 +15,12 @@ namespace pdvo::apps {
 namespace fs = std::filesystem;
 
 int RunAnnotateDepth(int argc, char** argv) {
-  CLI::App app("Finds the planes in each depth map of an RGB-D sequence (a TUM RGB-D folder or a synthetic street) "
-               "and writes one annotation per frame: large planar regions as `plane` shapes with their normals, "
-               "large clearly non-planar regions as `non-plane`. With --reference, compares them with reference "
-               "annotations (IoU and normal angle of matched planes).",
-               "pdvo annotate-depth");
+  CLI::App app(
+      "Finds the planes in each depth map of an RGB-D sequence (a TUM RGB-D folder or a synthetic street) "
+      "and writes one annotation per frame: large planar regions as `plane` shapes with their normals, "
+      "large clearly non-planar regions as `non-plane`. With --reference, compares them with reference "
+      "annotations (IoU and normal angle of matched planes).",
+      "pdvo annotate-depth");
   std::string sequence_path, out_dir, camera_path, config_path, reference_dir, json_path, verbosity = "info";
   std::vector<std::string> overrides;
   int every = 1;
@@ -58,8 +59,7 @@ int RunAnnotateDepth(int argc, char** argv) {
       continue;
     }
     const std::string name = fs::path(frame.image_path).stem().string() + ".json";
-    const std::string image_rel =
-        fs::relative(fs::absolute(frame.image_path), fs::absolute(out_dir)).generic_string();
+    const std::string image_rel = fs::relative(fs::absolute(frame.image_path), fs::absolute(out_dir)).generic_string();
     const Annotation annotation = finder.Annotate(frame.depth, image_rel);
     WriteAnnotation(out.path(name), annotation);
     ++written;
@@ -93,8 +93,8 @@ int RunAnnotateDepth(int argc, char** argv) {
     std::snprintf(buf, sizeof(buf),
                   "compared %d frames: %d of %d reference planes matched; median IoU %.3f (matched planes: %.3f); "
                   "normal angle median %.2f, mean %.2f, 90%% %.2f deg",
-                  s.frames, s.matched, s.reference_planes, s.median_iou, s.median_matched_iou, s.median_normal_angle_deg,
-                  s.mean_normal_angle_deg, s.p90_normal_angle_deg);
+                  s.frames, s.matched, s.reference_planes, s.median_iou, s.median_matched_iou,
+                  s.median_normal_angle_deg, s.mean_normal_angle_deg, s.p90_normal_angle_deg);
     PDVO_LOG(Info) << buf;
     if (!json_path.empty()) WriteFileAtomically(json_path, ToJson(comparisons).dump(1) + "\n");
   }

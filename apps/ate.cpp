@@ -11,12 +11,13 @@
 namespace pdvo::apps {
 
 int RunAte(int argc, char** argv) {
-  CLI::App app("Compares an estimated trajectory with ground truth: poses are associated by timestamp, the "
-               "estimate is aligned (se3: rigid; sim3: with scale, for monocular runs; none), and the absolute "
-               "trajectory error (ATE) and the relative pose error (RPE) are reported. The ATE's rotation part "
-               "compares the orientations after the rotation that best aligns them (the positions alone hardly "
-               "fix the rotation about a straight path).",
-               "pdvo ate");
+  CLI::App app(
+      "Compares an estimated trajectory with ground truth: poses are associated by timestamp, the "
+      "estimate is aligned (se3: rigid; sim3: with scale, for monocular runs; none), and the absolute "
+      "trajectory error (ATE) and the relative pose error (RPE) are reported. The ATE's rotation part "
+      "compares the orientations after the rotation that best aligns them (the positions alone hardly "
+      "fix the rotation about a straight path).",
+      "pdvo ate");
   std::string gt_path, est_path, format_name = "tum", align_name = "sim3", gt_times, est_times, json_path;
   std::string rpe_unit = "frames", verbosity = "info";
   double max_dt = 0.02, rpe_delta = 1;
@@ -42,20 +43,20 @@ int RunAte(int argc, char** argv) {
   const Trajectory gt = ReadTrajectory(gt_path, format, gt_times);
   const Trajectory est = ReadTrajectory(est_path, format, est_times);
   const AteResult ate = ComputeAte(gt, est, alignment, max_dt);
-  const RpeResult rpe = ComputeRpe(gt, est, max_dt, rpe_delta,
-                                   rpe_unit == "frames" ? RpeUnit::kFrames : RpeUnit::kSeconds,
-                                   ate.gt_from_estimate.scale);
+  const RpeResult rpe =
+      ComputeRpe(gt, est, max_dt, rpe_delta, rpe_unit == "frames" ? RpeUnit::kFrames : RpeUnit::kSeconds,
+                 ate.gt_from_estimate.scale);
   std::printf("matched poses   %zu of %zu (ground truth %zu)\n", ate.matched, est.size(), gt.size());
   std::printf("alignment       %s, scale %.6f\n", align_name.c_str(), ate.gt_from_estimate.scale);
   std::printf("ATE translation rmse %.6f  mean %.6f  median %.6f  max %.6f\n", ate.translation.rmse,
               ate.translation.mean, ate.translation.median, ate.translation.max);
   std::printf("ATE rotation    rmse %.4f  mean %.4f  median %.4f  max %.4f deg\n", ate.rotation_deg.rmse,
               ate.rotation_deg.mean, ate.rotation_deg.median, ate.rotation_deg.max);
-  std::printf("RPE (%g %s, %zu pairs) translation rmse %.6f, rotation rmse %.4f deg\n", rpe_delta,
-              rpe_unit.c_str(), rpe.pairs, rpe.translation.rmse, rpe.rotation_deg.rmse);
+  std::printf("RPE (%g %s, %zu pairs) translation rmse %.6f, rotation rmse %.4f deg\n", rpe_delta, rpe_unit.c_str(),
+              rpe.pairs, rpe.translation.rmse, rpe.rotation_deg.rmse);
   if (!json_path.empty()) {
-    nlohmann::json j = {{"gt", gt_path}, {"est", est_path}, {"align", align_name}, {"max_dt", max_dt},
-                        {"ate", ToJson(ate)}, {"rpe", ToJson(rpe)}};
+    nlohmann::json j = {{"gt", gt_path},    {"est", est_path},    {"align", align_name},
+                        {"max_dt", max_dt}, {"ate", ToJson(ate)}, {"rpe", ToJson(rpe)}};
     WriteFileAtomically(json_path, j.dump(1) + "\n");
   }
   return 0;

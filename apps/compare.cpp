@@ -11,10 +11,11 @@ namespace pdvo::apps {
 namespace fs = std::filesystem;
 
 int RunCompare(int argc, char** argv) {
-  CLI::App app("Matches the planes of estimated annotations (detections, or annotate-depth output) with those of "
-               "reference annotations of the same name, one to one by IoU, and reports IoU and normal angle per "
-               "frame and overall. A reference file without an estimate counts its planes as unmatched.",
-               "pdvo compare");
+  CLI::App app(
+      "Matches the planes of estimated annotations (detections, or annotate-depth output) with those of "
+      "reference annotations of the same name, one to one by IoU, and reports IoU and normal angle per "
+      "frame and overall. A reference file without an estimate counts its planes as unmatched.",
+      "pdvo compare");
   std::string reference_dir, estimate_dir, json_path, verbosity = "info";
   PlaneMatchOptions options;
   app.add_option("--reference,-r", reference_dir, "Folder of reference annotations")->required();

@@ -69,11 +69,12 @@ cv::Mat DrawStages(const cv::Mat& image, const Detections& d, const Annotation& 
 }  // namespace
 
 int RunDetect(int argc, char** argv) {
-  CLI::App app("Finds the planes in single images with the windowed detector: windows recognised at several sizes, "
-               "per-point planarity and normal, MRF segmentation, each segment recognised again. Writes one "
-               "annotation (LabelMe JSON with normals and scores, ../shared/ANNOTATIONS.md) per image, named after "
-               "the image. All options: infer/config/detector.yaml.",
-               "pdvo detect");
+  CLI::App app(
+      "Finds the planes in single images with the windowed detector: windows recognised at several sizes, "
+      "per-point planarity and normal, MRF segmentation, each segment recognised again. Writes one "
+      "annotation (LabelMe JSON with normals and scores, ../shared/ANNOTATIONS.md) per image, named after "
+      "the image. All options: infer/config/detector.yaml.",
+      "pdvo detect");
   std::string model_path = "models/default/model.yml", input, out_dir, camera_path, config_path, verbosity = "info";
   std::vector<std::string> overrides;
   size_t max_frames = 0;
@@ -91,8 +92,7 @@ int RunDetect(int argc, char** argv) {
                "Also write <name>_stages.png per image: the windows' plane probability, each point's planarity and "
                "normal, the MRFs' labels (non-planar points white) and the final planes, side by side (the paper's "
                "Fig. 3)");
-  AddConfigFlags(app, &config_path, &overrides, "Detector options (YAML, section 'detector')",
-                 "plane_smoothness=2");
+  AddConfigFlags(app, &config_path, &overrides, "Detector options (YAML, section 'detector')", "plane_smoothness=2");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
@@ -155,7 +155,8 @@ int RunDetect(int argc, char** argv) {
   for (const auto& [path, image] : single) detect(path, image, json_name(path));
   Frame frame;
   while (sequence && done < total && sequence->Next(&frame)) {
-    PDVO_THROW_CHECK(!frame.image_path.empty(), InvalidArgument, input << ": the detector needs image files, not a video");
+    PDVO_THROW_CHECK(!frame.image_path.empty(), InvalidArgument,
+                     input << ": the detector needs image files, not a video");
     detect(frame.image_path, frame.image, json_name(frame.image_path));
   }
   for (size_t k = 0; k < annotated.size() && done < total; ++k) {

@@ -10,12 +10,13 @@
 namespace pdvo::apps {
 
 int RunEvaluate(int argc, char** argv) {
-  CLI::App app("Measures a model on annotated images: regions are sampled from the annotations as in training "
-               "(each polygon and sub-windows pure in its label, squares unless max_window_aspect > 1, seeded), "
-               "recognised, and compared with their labels and normals. Reports accuracy, balanced accuracy, "
-               "precision / recall of 'plane', ROC AUC, the confusion matrix and normal errors, overall and per "
-               "image.",
-               "pdvo evaluate");
+  CLI::App app(
+      "Measures a model on annotated images: regions are sampled from the annotations as in training "
+      "(each polygon and sub-windows pure in its label, squares unless max_window_aspect > 1, seeded), "
+      "recognised, and compared with their labels and normals. Reports accuracy, balanced accuracy, "
+      "precision / recall of 'plane', ROC AUC, the confusion matrix and normal errors, overall and per "
+      "image.",
+      "pdvo evaluate");
   std::vector<std::string> inputs, overrides;
   std::string model_path, json_path, config_path, verbosity = "info";
   uint64_t seed = 1;
@@ -71,8 +72,11 @@ int RunEvaluate(int argc, char** argv) {
   std::printf("normal error over %d planes: mean %.2f, median %.2f, 90%% %.2f deg\n", m.normals, m.normal_mean,
               m.normal_median, m.normal_p90);
   if (!json_path.empty()) {
-    nlohmann::json report = {{"model", model_path}, {"images", rows.size()}, {"skipped", skipped},
-                             {"overall", ToJson(m)}, {"per_image", per_image_json}};
+    nlohmann::json report = {{"model", model_path},
+                             {"images", rows.size()},
+                             {"skipped", skipped},
+                             {"overall", ToJson(m)},
+                             {"per_image", per_image_json}};
     WriteFileAtomically(json_path, report.dump(1) + "\n");
   }
   return 0;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 struct PlaneSource::Impl {
   Camera working;
   std::string description;
-  std::unique_ptr<Detector> detector;                      // model
+  std::unique_ptr<Detector> detector;                       // model
   std::map<std::string, std::vector<DetectedPlane>> files;  // folder, oracle: by image stem
   std::mutex mutex;                                         // guards names
   std::vector<std::string> names;                           // by frame: image stems

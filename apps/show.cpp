@@ -13,10 +13,11 @@
 namespace pdvo::apps {
 
 int RunShow(int argc, char** argv) {
-  CLI::App app("Draws annotations over their images: planes tinted by their normal (with an arrow), non-planes "
-               "hatched, unknown pixels untouched, and a legend. Several annotations make a contact sheet: their "
-               "overlays side by side, in rows of --columns, the images next to them with --with-image.",
-               "pdvo show");
+  CLI::App app(
+      "Draws annotations over their images: planes tinted by their normal (with an arrow), non-planes "
+      "hatched, unknown pixels untouched, and a legend. Several annotations make a contact sheet: their "
+      "overlays side by side, in rows of --columns, the images next to them with --with-image.",
+      "pdvo show");
   std::vector<std::string> annotation_paths;
   std::string out_path, image_path, verbosity = "info";
   OverlayOptions options;
@@ -28,7 +29,9 @@ int RunShow(int argc, char** argv) {
   app.add_option("--max-width", options.max_width, "Scale larger images down to this width")->capture_default_str();
   app.add_option("--alpha", options.alpha, "Opacity of the tint, 0-1")->capture_default_str();
   app.add_flag("!--no-legend", options.legend, "Leave out the legend panel");
-  app.add_option("--columns", columns, "Contact sheet: tiles per row")->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--columns", columns, "Contact sheet: tiles per row")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_flag("--with-image", with_image, "Contact sheet: show each image beside its overlay");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);

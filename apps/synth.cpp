@@ -1,16 +1,17 @@
 // pdvo synth: a synthetic urban street sequence with exact ground truth.
+#include "pdvo/sim/synth.h"
 #include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
-#include "pdvo/sim/synth.h"
 #include "tool.h"
 
 namespace pdvo::apps {
 
 int RunSynth(int argc, char** argv) {
-  CLI::App app("Renders a procedurally generated urban street, walked by a hand-held camera at 1.4 m/s and 30 Hz, "
-               "into a folder the TUM reader reads: images, metric depth, plane ids, exact poses, the world's "
-               "planes and one annotation per frame. The same seed and options give the same files.",
-               "pdvo synth");
+  CLI::App app(
+      "Renders a procedurally generated urban street, walked by a hand-held camera at 1.4 m/s and 30 Hz, "
+      "into a folder the TUM reader reads: images, metric depth, plane ids, exact poses, the world's "
+      "planes and one annotation per frame. The same seed and options give the same files.",
+      "pdvo synth");
   std::string out_dir, config_path, verbosity = "info";
   std::vector<std::string> overrides;
   uint64_t seed = 1;

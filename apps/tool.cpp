@@ -8,8 +8,7 @@
 namespace pdvo::apps {
 
 void AddVerbosityFlag(CLI::App& app, std::string* verbosity) {
-  app.add_option("--verbosity,-v", *verbosity, "Log level: error, warning, info or debug")
-      ->capture_default_str();
+  app.add_option("--verbosity,-v", *verbosity, "Log level: error, warning, info or debug")->capture_default_str();
 }
 
 void AddConfigFlags(CLI::App& app, std::string* config_path, std::vector<std::string>* overrides,
@@ -23,7 +22,7 @@ void ApplyVerbosity(const std::string& verbosity) {
   SetLogLevel(level);
   // OpenCV's own messages would break the one-line errors; they are shown only when debugging.
   cv::utils::logging::setLogLevel(level == LogLevel::kDebug ? cv::utils::logging::LOG_LEVEL_WARNING
-                                                           : cv::utils::logging::LOG_LEVEL_SILENT);
+                                                            : cv::utils::logging::LOG_LEVEL_SILENT);
 }
 
 Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path, const std::string& camera_path) {

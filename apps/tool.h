@@ -18,16 +18,16 @@ void AddVerbosityFlag(CLI::App& app, std::string* verbosity);
 void ApplyVerbosity(const std::string& verbosity);
 
 // Parses a subcommand's flags: --help prints and returns 0; a usage error is one line and returns 1.
-#define PDVO_PARSE_FLAGS(app, argc, argv)                                                          \
-  do {                                                                                             \
-    try {                                                                                          \
-      (app).parse((argc), (argv));                                                                 \
-    } catch (const CLI::CallForHelp& e) {                                                          \
-      return (app).exit(e);                                                                        \
-    } catch (const CLI::ParseError& e) {                                                           \
-      std::cerr << (app).get_name() << ": error: " << e.what() << " (see --help)\n";               \
-      return 1;                                                                                    \
-    }                                                                                              \
+#define PDVO_PARSE_FLAGS(app, argc, argv)                                            \
+  do {                                                                               \
+    try {                                                                            \
+      (app).parse((argc), (argv));                                                   \
+    } catch (const CLI::CallForHelp& e) {                                            \
+      return (app).exit(e);                                                          \
+    } catch (const CLI::ParseError& e) {                                             \
+      std::cerr << (app).get_name() << ": error: " << e.what() << " (see --help)\n"; \
+      return 1;                                                                      \
+    }                                                                                \
   } while (false)
 
 // Adds --config FILE and repeatable --set key=value.

@@ -11,11 +11,12 @@
 namespace pdvo::apps {
 
 int RunTrain(int argc, char** argv) {
-  CLI::App app("Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
-               "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
-               "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. "
-               "Writes one model file (YAML) holding everything inference needs and a training card.",
-               "pdvo train");
+  CLI::App app(
+      "Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
+      "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
+      "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. "
+      "Writes one model file (YAML) holding everything inference needs and a training card.",
+      "pdvo train");
   std::vector<std::string> inputs, overrides;
   std::string out_path, config_path, verbosity = "info";
   uint64_t seed = 1;
@@ -45,11 +46,12 @@ int RunTrain(int argc, char** argv) {
   for (const RvmFunction& f : model.classifiers) {
     classifier_sizes += (classifier_sizes.empty() ? "" : "/") + std::to_string(f.size());
   }
-  std::printf("wrote %s: %d images, %d+%d regions per classifier, cv accuracy %.3f, cv normal error %.1f deg, "
-              "relevance vectors %s (%zu classifiers) %d/%d/%d (normal); peak memory %.0f MiB\n",
-              out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
-              model.card.cv_accuracy, model.card.cv_normal_error, classifier_sizes.c_str(), model.classifiers.size(),
-              model.normal[0].size(), model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
+  std::printf(
+      "wrote %s: %d images, %d+%d regions per classifier, cv accuracy %.3f, cv normal error %.1f deg, "
+      "relevance vectors %s (%zu classifiers) %d/%d/%d (normal); peak memory %.0f MiB\n",
+      out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
+      model.card.cv_accuracy, model.card.cv_normal_error, classifier_sizes.c_str(), model.classifiers.size(),
+      model.normal[0].size(), model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
   return 0;
 }
 

@@ -30,9 +30,10 @@ std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inp
 }
 
 int RunValidate(int argc, char** argv) {
-  CLI::App app("Checks annotation files against the rules of the format (ANNOTATIONS.md) and prints one line per "
-               "error or warning. Exits with 2 if any file has an error.",
-               "pdvo validate");
+  CLI::App app(
+      "Checks annotation files against the rules of the format (ANNOTATIONS.md) and prints one line per "
+      "error or warning. Exits with 2 if any file has an error.",
+      "pdvo validate");
   std::vector<std::string> inputs;
   std::string verbosity = "info";
   app.add_option("inputs", inputs, "Annotation files or folders of them")->required();

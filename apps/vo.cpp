@@ -24,8 +24,8 @@ namespace {
 // The frame with its features: points green, plane points in a colour per plane; filled where the update used
 // the match, hollow where the search failed, red where RANSAC rejected the match. The polygons of the newest
 // detections (keyframe pixels) in yellow.
-cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations,
-                    const vo::FrameStats& s, const std::vector<DetectedPlane>& detected) {
+cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations, const vo::FrameStats& s,
+                    const std::vector<DetectedPlane>& detected) {
   cv::Mat out = colour.clone();
   for (const DetectedPlane& p : detected) {
     std::vector<cv::Point> outline;
@@ -33,12 +33,11 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
     cv::polylines(out, std::vector<std::vector<cv::Point>>{outline}, true, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
   }
   for (const vo::Observation& o : observations) {
-    const cv::Scalar c = o.matched && !o.used ? cv::Scalar(0, 0, 255)
-                         : o.plane < 0        ? cv::Scalar(0, 220, 0)
-                                              : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196,
-                                                           60 + (o.plane * 199) % 196);
-    cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.used ? cv::FILLED : 1,
-               cv::LINE_AA);
+    const cv::Scalar c =
+        o.matched && !o.used ? cv::Scalar(0, 0, 255)
+        : o.plane < 0        ? cv::Scalar(0, 220, 0)
+                      : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196, 60 + (o.plane * 199) % 196);
+    cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.used ? cv::FILLED : 1, cv::LINE_AA);
   }
   char text[128];
   std::snprintf(text, sizeof(text), "t %.2f  %d/%d matched  %d points  %d planes%s", s.timestamp, s.measurements,
@@ -58,9 +57,14 @@ nlohmann::json DetectionJson(const vo::DetectionEvent& e, double now) {
                       {"detector_seconds", e.result.seconds},
                       {"detected", e.result.planes.size()},
                       {"seeded", o.seeded},
-                      {"discarded", {{"small", o.small}, {"too_many", o.too_many}, {"near_plane", o.near_plane},
-                                     {"mapped", o.mapped},
-                                     {"no_corner", o.no_corner}, {"grazing", o.grazing}, {"invalid", o.invalid}}},
+                      {"discarded",
+                       {{"small", o.small},
+                        {"too_many", o.too_many},
+                        {"near_plane", o.near_plane},
+                        {"mapped", o.mapped},
+                        {"no_corner", o.no_corner},
+                        {"grazing", o.grazing},
+                        {"invalid", o.invalid}}},
                       {"keyframe_gone", e.keyframe_gone}};
   if (!e.result.error.empty()) j["error"] = e.result.error;
   return j;
@@ -69,12 +73,13 @@ nlohmann::json DetectionJson(const vo::DetectionEvent& e, double now) {
 }  // namespace
 
 int RunVo(int argc, char** argv) {
-  CLI::App app("Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
-               "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to "
-               "the working width. Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and "
-               "totals), map.ply (points, planes as polygons, the camera path) and vo.yaml (the options used) to "
-               "the output folder. All options: vo/config/default.yaml.",
-               "pdvo vo");
+  CLI::App app(
+      "Monocular visual odometry: an EKF with inverse-depth points and planes anchored at keyframes "
+      "(the IDPP system with --mode idpp; points only by default). Frames are undistorted and resized to "
+      "the working width. Writes trajectory.txt (world_from_cam per frame), stats.json (per frame and "
+      "totals), map.ply (points, planes as polygons, the camera path) and vo.yaml (the options used) to "
+      "the output folder. All options: vo/config/default.yaml.",
+      "pdvo vo");
   std::string sequence_path, camera_path, out_dir, config_path, format_name = "tum", mode, verbosity = "info";
   std::vector<std::string> overrides;
   size_t max_frames = 0;
@@ -103,9 +108,9 @@ int RunVo(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
-  const bool mode_set = !mode.empty() || !config_path.empty() ||
-                        std::any_of(overrides.begin(), overrides.end(),
-                                    [](const std::string& o) { return o.rfind("mode=", 0) == 0; });
+  const bool mode_set =
+      !mode.empty() || !config_path.empty() ||
+      std::any_of(overrides.begin(), overrides.end(), [](const std::string& o) { return o.rfind("mode=", 0) == 0; });
   if (!mode_set && std::filesystem::exists(model_path)) mode = "pdvo";
   if (!mode.empty()) overrides.push_back("mode=" + mode);
   const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
@@ -119,8 +124,8 @@ int RunVo(int argc, char** argv) {
   std::unique_ptr<PlaneSource> planes;
   if (pdvo) planes = std::make_unique<PlaneSource>(source, model_path, sequence_path, working);
   vo::Odometry odometry(working, options, nullptr, planes ? planes->detector() : vo::PlaneDetector());
-  PDVO_LOG(Info) << "vo (mode " << OptionName(options.mode) << ") on " << sequence->Describe() << " at " << width
-                 << "x" << height << (planes ? ", planes from " + planes->Describe() : "");
+  PDVO_LOG(Info) << "vo (mode " << OptionName(options.mode) << ") on " << sequence->Describe() << " at " << width << "x"
+                 << height << (planes ? ", planes from " + planes->Describe() : "");
 
   StagedOutputDir out(out_dir);
   SaveOptions(out.path("vo.yaml"), options, "vo");
@@ -155,11 +160,19 @@ int RunVo(int argc, char** argv) {
     keyframes += s.keyframe;
     ++tracked;
     waited += s.detector_wait_seconds;
-    frames.push_back({{"t", s.timestamp}, {"seconds", s.seconds}, {"attempted", s.attempted},
-                      {"measurements", s.measurements}, {"points", s.points}, {"planes", s.planes},
-                      {"plane_points", s.plane_points}, {"plane_measurements", s.plane_measurements},
-                      {"state", s.state_size}, {"keyframe", s.keyframe}, {"lost", s.lost},
-                      {"bootstrap", s.bootstrap}, {"update", vo::ToString(s.update)}});
+    frames.push_back({{"t", s.timestamp},
+                      {"seconds", s.seconds},
+                      {"attempted", s.attempted},
+                      {"measurements", s.measurements},
+                      {"points", s.points},
+                      {"planes", s.planes},
+                      {"plane_points", s.plane_points},
+                      {"plane_measurements", s.plane_measurements},
+                      {"state", s.state_size},
+                      {"keyframe", s.keyframe},
+                      {"lost", s.lost},
+                      {"bootstrap", s.bootstrap},
+                      {"update", vo::ToString(s.update)}});
     update_failures += s.update != vo::UpdateStatus::kOk && s.update != vo::UpdateStatus::kNoMeasurements;
     if (overlay) video.write(DrawOverlay(prepared.colour, odometry.observations(), s, newest_detections));
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
@@ -198,9 +211,12 @@ int RunVo(int argc, char** argv) {
       detected += d["detected"].get<int>();
       seeded += d["seeded"].get<int>();
     }
-    stats["totals"]["detections"] = {{"keyframes_detected", detections.size()}, {"skipped", counts.skipped},
-                                     {"timed_out", counts.timed_out}, {"failed", counts.failed},
-                                     {"keyframe_gone", keyframes_gone}, {"planes_detected", detected},
+    stats["totals"]["detections"] = {{"keyframes_detected", detections.size()},
+                                     {"skipped", counts.skipped},
+                                     {"timed_out", counts.timed_out},
+                                     {"failed", counts.failed},
+                                     {"keyframe_gone", keyframes_gone},
+                                     {"planes_detected", detected},
                                      {"planes_seeded", seeded}};
     stats["totals"]["detector_wait_seconds"] = waited;
     stats["detections"] = detections;
@@ -211,11 +227,12 @@ int RunVo(int argc, char** argv) {
   }
   WriteFileAtomically(out.path("stats.json"), stats.dump(1) + "\n");
   out.Commit();
-  std::printf("%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times; %d planes, "
-              "%.1f points per plane, mean area %.0f px; wrote %s\n",
-              trajectory.size(), fps,
-              waited > 0 ? (", and it waited " + std::to_string(waited).substr(0, 5) + " s for the detector").c_str() : "",
-              keyframes, lost, mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, out_dir.c_str());
+  std::printf(
+      "%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times; %d planes, "
+      "%.1f points per plane, mean area %.0f px; wrote %s\n",
+      trajectory.size(), fps,
+      waited > 0 ? (", and it waited " + std::to_string(waited).substr(0, 5) + " s for the detector").c_str() : "",
+      keyframes, lost, mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, out_dir.c_str());
   return 0;
 }
 

@@ -10,22 +10,22 @@
 // (the detector's thread excluded; the deterministic schedule's waits excluded).
 // Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5,
 //        and for mode=pdvo source=model|oracle model=PATH)
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <array>
 #include <map>
 #include <set>
 
 #include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 
+#include "memory.h"
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
 #include "pdvo/infer/detector.h"
-#include "memory.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
 #include "pdvo/vo/frames.h"
@@ -209,8 +209,8 @@ int main(int argc, char** argv) {
     if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points || !normals.count(key)) {
       continue;
     }
-    const auto main = std::max_element(votes.begin(), votes.end(),
-                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    const auto main =
+        std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
     if (std::getenv("VO_BENCH_PLANES")) {
       std::printf("plane k%d id%d:", key.first, key.second);
       for (const auto& [pid, n] : votes) {
@@ -246,12 +246,13 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(), path);
   std::printf("  tracking         %.1f frames/s (one thread; target >= 200); tracking thread's CPU %.1f frames/s\n",
               frames / seconds, frames / cpu_seconds);
-  std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n",
-              ate.translation.rmse, 100 * ate.translation.rmse / path, ate.translation.max);
-  std::printf("  NEES orientation mean %.2f (chi-square(3): 3), %.1f%% of frames inside the 95%% bound (7.81); "
-              "relative to the newest keyframe %.2f\n",
-              nees_sum / std::max(1, nees_frames), 100.0 * nees_inside / std::max(1, nees_frames),
-              relative_nees_sum / std::max(1, nees_frames));
+  std::printf("  ATE (Sim3)       rmse %.3f m = %.2f%% of the path (target <= 1%%), max %.3f m\n", ate.translation.rmse,
+              100 * ate.translation.rmse / path, ate.translation.max);
+  std::printf(
+      "  NEES orientation mean %.2f (chi-square(3): 3), %.1f%% of frames inside the 95%% bound (7.81); "
+      "relative to the newest keyframe %.2f\n",
+      nees_sum / std::max(1, nees_frames), 100.0 * nees_inside / std::max(1, nees_frames),
+      relative_nees_sum / std::max(1, nees_frames));
   std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times; two-view bootstrap at frame %d\n",
               measurements / frames, keyframes, lost, bootstrap);
   if (plane_members > 0) {
@@ -265,17 +266,19 @@ int main(int argc, char** argv) {
   }
   if (pdvo_mode) {
     const pdvo::vo::Odometry::DetectionCounts counts = odometry.detection_counts();
-    std::printf("  detections       source %s: %d planes detected, %d seeded; %d keyframes dropped (left the "
-                "filter), %d skipped, %d timed out, %d failed\n",
-                source.c_str(), detected, seeded, dropped, counts.skipped, counts.timed_out, counts.failed);
+    std::printf(
+        "  detections       source %s: %d planes detected, %d seeded; %d keyframes dropped (left the "
+        "filter), %d skipped, %d timed out, %d failed\n",
+        source.c_str(), detected, seeded, dropped, counts.skipped, counts.timed_out, counts.failed);
   }
   // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
-  std::printf("result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
-              "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu seeded=%d curve=",
-              static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
-              pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds,
-              mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
-              normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(), seeded);
+  std::printf(
+      "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
+      "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu seeded=%d curve=",
+      static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
+      pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
+      mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
+      normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(), seeded);
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
@@ -285,7 +288,7 @@ int main(int argc, char** argv) {
     std::printf("%s%.1f", w ? "," : "", n / std::max(t, 1e-9));
   }
   std::printf("\n");
-  std::printf("  memory           %.1f MiB resident with the frames, tracking added %.1f MiB (peak %.1f MiB)\n",
-              before, peak - before, peak);
+  std::printf("  memory           %.1f MiB resident with the frames, tracking added %.1f MiB (peak %.1f MiB)\n", before,
+              peak - before, peak);
   return 0;
 }

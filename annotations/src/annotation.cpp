@@ -12,9 +12,7 @@ namespace pdvo {
 namespace {
 using nlohmann::json;
 
-std::string ShapeWhere(const std::string& where, size_t index) {
-  return where + ": shape " + std::to_string(index);
-}
+std::string ShapeWhere(const std::string& where, size_t index) { return where + ": shape " + std::to_string(index); }
 
 double Number(const json& value, const std::string& where, const char* key) {
   PDVO_THROW_CHECK(value.is_number(), FormatError, where << ": '" << key << "' must be a number");
@@ -128,8 +126,8 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   PDVO_THROW_CHECK(shapes.is_array(), FormatError, where << ": 'shapes' must be a list");
   for (size_t i = 0; i < shapes.size(); ++i) a.shapes.push_back(ParseShape(shapes[i], ShapeWhere(where, i)));
   for (const auto& [key, value] : j.items()) {
-    if (key != "version" && key != "imagePath" && key != "imageWidth" && key != "imageHeight" &&
-        key != "camera" && key != "shapes" && key != "imageData") {
+    if (key != "version" && key != "imagePath" && key != "imageWidth" && key != "imageHeight" && key != "camera" &&
+        key != "shapes" && key != "imageData") {
       a.extra[key] = value;
     }
   }
@@ -221,12 +219,12 @@ std::vector<ValidationIssue> Validate(const Annotation& a) {
   auto error = [&](int shape, std::string message) { issues.push_back({true, shape, std::move(message)}); };
   auto warning = [&](int shape, std::string message) { issues.push_back({false, shape, std::move(message)}); };
   if (a.image_width <= 0 || a.image_height <= 0) {
-    error(-1, "image size " + std::to_string(a.image_width) + "x" + std::to_string(a.image_height) +
-                  " is not positive");
+    error(-1,
+          "image size " + std::to_string(a.image_width) + "x" + std::to_string(a.image_height) + " is not positive");
     return issues;
   }
-  if (a.camera && !(a.camera->fx > 0 && a.camera->fy > 0 && std::isfinite(a.camera->cx) &&
-                    std::isfinite(a.camera->cy))) {
+  if (a.camera &&
+      !(a.camera->fx > 0 && a.camera->fy > 0 && std::isfinite(a.camera->cx) && std::isfinite(a.camera->cy))) {
     error(-1, "camera intrinsics are not valid (fx, fy must be positive)");
   }
   bool geometry_ok = true;
@@ -263,8 +261,8 @@ std::vector<ValidationIssue> Validate(const Annotation& a) {
     for (const auto& p : s.points) {
       if (p.x() < -0.5 || p.y() < -0.5 || p.x() > a.image_width - 0.5 || p.y() > a.image_height - 0.5) {
         char buf[160];
-        std::snprintf(buf, sizeof(buf), "point (%.1f, %.1f) is outside the %dx%d image", p.x(), p.y(),
-                      a.image_width, a.image_height);
+        std::snprintf(buf, sizeof(buf), "point (%.1f, %.1f) is outside the %dx%d image", p.x(), p.y(), a.image_width,
+                      a.image_height);
         error(index, buf);
         break;
       }

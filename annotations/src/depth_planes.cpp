@@ -121,8 +121,7 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
   }
   const int r = o.normal_radius, window = (2 * r + 1) * (2 * r + 1);
   cv::Mat sums;
-  cv::boxFilter(moments, sums, CV_64F, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false,
-                cv::BORDER_CONSTANT);
+  cv::boxFilter(moments, sums, CV_64F, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
 
   // 2. Local plane fits: normal and RMS residual (in sigma) per pixel with enough valid neighbours.
   std::vector<Eigen::Vector3d> local_normal(n_pixels, Eigen::Vector3d::Zero());
@@ -148,8 +147,7 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
   for (int i = 0; i < n_pixels; ++i) {
     if (local_residual[i] >= 0 && local_residual[i] < o.seed_max_residual) order.push_back(i);
   }
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return local_residual[a] < local_residual[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return local_residual[a] < local_residual[b]; });
   const double cos_max = std::cos(o.max_normal_angle_deg * M_PI / 180.0);
   const int min_plane_pixels = static_cast<int>(o.min_plane_fraction * n_pixels);
   const int offsets[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
@@ -234,8 +232,8 @@ std::vector<DepthPlane> DepthPlaneFinder::FindPlanes(const cv::Mat& depth, cv::M
       if (q < 0 || label[q] < 0 || label[q] == label[p]) continue;
       const int a = std::min(label[p], label[q]), b = std::max(label[p], label[q]);
       ++seam[a * n_regions + b];
-      const bool fits = std::max({residual_of(p, regions[label[q]]), residual_of(q, regions[label[p]])}) <
-                        o.inlier_sigmas;
+      const bool fits =
+          std::max({residual_of(p, regions[label[q]]), residual_of(q, regions[label[p]])}) < o.inlier_sigmas;
       seam_fit[a * n_regions + b] += fits;
     }
   }

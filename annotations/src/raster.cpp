@@ -24,8 +24,8 @@ std::vector<cv::Point> ScaledPolygon(const AnnotationShape& shape, const Annotat
 
 cv::Size SizeOr(const Annotation& a, cv::Size size) {
   if (size.empty()) size = cv::Size(a.image_width, a.image_height);
-  PDVO_THROW_CHECK(size.width > 0 && size.height > 0 && a.image_width > 0 && a.image_height > 0,
-                   InvalidArgument, "rasterise: image size must be positive");
+  PDVO_THROW_CHECK(size.width > 0 && size.height > 0 && a.image_width > 0 && a.image_height > 0, InvalidArgument,
+                   "rasterise: image size must be positive");
   return size;
 }
 
@@ -61,9 +61,9 @@ AnnotationMasks Rasterise(const Annotation& a, cv::Size size) {
     if ((!s.IsPlane() && !s.IsNonPlane()) || s.points.size() < 3) continue;
     const std::vector<std::vector<cv::Point>> polys = {ScaledPolygon(s, a, size)};
     const cv::Rect box = cv::boundingRect(polys[0]);
-    const cv::Rect roi = cv::Rect(box.x >> kShift, box.y >> kShift, (box.width >> kShift) + 2,
-                                  (box.height >> kShift) + 2) &
-                         cv::Rect(0, 0, size.width, size.height);
+    const cv::Rect roi =
+        cv::Rect(box.x >> kShift, box.y >> kShift, (box.width >> kShift) + 2, (box.height >> kShift) + 2) &
+        cv::Rect(0, 0, size.width, size.height);
     if (roi.empty()) continue;
     cv::Mat mask(roi.size(), CV_8U, cv::Scalar(0));
     // The offset is in the same fixed-point units as the points.
@@ -139,8 +139,8 @@ void DrawLegend(cv::Mat& panel, double scale) {
       const double x = static_cast<double>(dx) / r, yy = static_cast<double>(dy) / r;
       if (x * x + yy * yy > 1) continue;
       const cv::Scalar col = NormalColour(Eigen::Vector3d(x, yy, -std::sqrt(1 - x * x - yy * yy)));
-      panel.at<cv::Vec3b>(c.y + dy, c.x + dx) = cv::Vec3b(static_cast<uchar>(col[0]), static_cast<uchar>(col[1]),
-                                                          static_cast<uchar>(col[2]));
+      panel.at<cv::Vec3b>(c.y + dy, c.x + dx) =
+          cv::Vec3b(static_cast<uchar>(col[0]), static_cast<uchar>(col[1]), static_cast<uchar>(col[2]));
     }
   }
   // Each point of the disc is the colour of a plane facing that way: left, right, up, down.
@@ -216,8 +216,8 @@ cv::Mat DrawOverlay(const cv::Mat& image_in, const Annotation& a, const OverlayO
       centre += q;
     }
     centre *= 1.0 / static_cast<double>(shape.points.size());
-    const cv::Scalar outline = shape.IsPlane() && shape.normal ? NormalColour(shape.normal->normalized())
-                                                               : cv::Scalar(60, 60, 220);
+    const cv::Scalar outline =
+        shape.IsPlane() && shape.normal ? NormalColour(shape.normal->normalized()) : cv::Scalar(60, 60, 220);
     cv::polylines(out, poly, true, cv::Scalar(0, 0, 0), static_cast<int>(3 * s), cv::LINE_AA);
     cv::polylines(out, poly, true, outline, static_cast<int>(std::max(1.0, 1.5 * s)), cv::LINE_AA);
     if (shape.IsPlane() && shape.normal && shape.normal->allFinite() && shape.normal->norm() > 0) {

@@ -53,8 +53,8 @@ std::vector<LabelledRegion> SampleRegions(const Annotation& a, cv::Size size, co
       out.push_back(std::move(r));
     }
     // The largest size that fits the box at some allowed aspect ratio.
-    const double fitting = std::min({std::sqrt(o.max_window_aspect) * std::min(box.width, box.height),
-                                     std::sqrt(static_cast<double>(box.area()))});
+    const double fitting = std::min(
+        {std::sqrt(o.max_window_aspect) * std::min(box.width, box.height), std::sqrt(static_cast<double>(box.area()))});
     const int largest = static_cast<int>(std::min<double>(largest_side, fitting));
     if (o.windows_per_shape == 0 || largest < o.min_window) continue;
     cv::Mat inside;  // integral image of the shape's pixels: a window is pure if it counts its own area

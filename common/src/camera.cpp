@@ -13,8 +13,7 @@ namespace pdvo {
 namespace {
 constexpr const char* kDistortionKeys[5] = {"k1", "k2", "p1", "p2", "k3"};
 
-double ReadNumber(const cv::FileNode& node, const char* key, const std::string& where, bool required,
-                  double fallback) {
+double ReadNumber(const cv::FileNode& node, const char* key, const std::string& where, bool required, double fallback) {
   const cv::FileNode child = node[key];
   if (child.empty() || child.isNone()) {
     PDVO_THROW_CHECK(!required, FormatError, where << ": missing key '" << key << "'");
@@ -59,8 +58,9 @@ void Camera::Write(const std::string& path) const {
 }
 
 void Camera::Write(cv::FileStorage& fs) const {
-  fs << "camera" << "{" << "width" << width << "height" << height << "fx" << fx << "fy" << fy << "cx" << cx
-     << "cy" << cy;
+  fs << "camera"
+     << "{"
+     << "width" << width << "height" << height << "fx" << fx << "fy" << fy << "cx" << cx << "cy" << cy;
   for (int i = 0; i < 5; ++i) fs << kDistortionKeys[i] << distortion[i];
   if (depth_scale > 0) fs << "depth_scale" << depth_scale;
   fs << "}";
@@ -73,8 +73,7 @@ void Camera::Check(const std::string& where) const {
                    where << ": focal lengths must be positive and finite, got fx=" << fx << " fy=" << fy);
   PDVO_THROW_CHECK(std::isfinite(depth_scale) && depth_scale >= 0, InvalidArgument,
                    where << ": depth_scale must be positive, got " << depth_scale);
-  PDVO_THROW_CHECK(std::isfinite(cx) && std::isfinite(cy), InvalidArgument,
-                   where << ": principal point is not finite");
+  PDVO_THROW_CHECK(std::isfinite(cx) && std::isfinite(cy), InvalidArgument, where << ": principal point is not finite");
   for (int i = 0; i < 5; ++i) {
     PDVO_THROW_CHECK(std::isfinite(distortion[i]), InvalidArgument,
                      where << ": distortion " << kDistortionKeys[i] << " is not finite");
@@ -151,9 +150,9 @@ Camera Camera::Pinhole(int width, int height, double fx, double fy, double cx, d
 }
 
 Camera Camera::WithFieldOfView(int width, int height, double horizontal_fov_deg) {
-  PDVO_THROW_CHECK(width > 0 && height > 0 && horizontal_fov_deg > 0 && horizontal_fov_deg < 180, InvalidArgument,
-                   "camera: a " << width << "x" << height << " image with a field of view of " << horizontal_fov_deg
-                                << " degrees");
+  PDVO_THROW_CHECK(
+      width > 0 && height > 0 && horizontal_fov_deg > 0 && horizontal_fov_deg < 180, InvalidArgument,
+      "camera: a " << width << "x" << height << " image with a field of view of " << horizontal_fov_deg << " degrees");
   Camera c;
   c.width = width;
   c.height = height;
@@ -165,14 +164,14 @@ Camera Camera::WithFieldOfView(int width, int height, double horizontal_fov_deg)
 
 Undistorter::Undistorter(const Camera& camera) : camera_(camera) {
   const cv::Mat dist(1, 5, CV_64F, const_cast<double*>(camera.distortion.data()));
-  cv::initUndistortRectifyMap(camera.K(), dist, cv::noArray(), camera.K(),
-                              cv::Size(camera.width, camera.height), CV_16SC2, map1_, map2_);
+  cv::initUndistortRectifyMap(camera.K(), dist, cv::noArray(), camera.K(), cv::Size(camera.width, camera.height),
+                              CV_16SC2, map1_, map2_);
 }
 
 cv::Mat Undistorter::Apply(const cv::Mat& image, int interpolation) const {
   PDVO_THROW_CHECK(image.cols == camera_.width && image.rows == camera_.height, InvalidArgument,
-                   "undistort: image is " << image.cols << "x" << image.rows << " but the camera is "
-                                          << camera_.width << "x" << camera_.height);
+                   "undistort: image is " << image.cols << "x" << image.rows << " but the camera is " << camera_.width
+                                          << "x" << camera_.height);
   cv::Mat out;
   cv::remap(image, out, map1_, map2_, interpolation, cv::BORDER_CONSTANT);
   return out;

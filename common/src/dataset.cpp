@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 bool HasImageExtension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".ppm" || ext == ".pgm";
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" || ext == ".tiff" ||
+         ext == ".ppm" || ext == ".pgm";
 }
 
 namespace {
@@ -123,8 +123,8 @@ std::unique_ptr<Sequence> OpenTum(const fs::path& root, const SequenceOptions& o
     entries.push_back(std::move(e));
   }
   if (without_depth > 0) {
-    PDVO_LOG(Warning) << root.string() << ": " << without_depth
-                      << " images have no depth map within " << options.max_association_dt << " s";
+    PDVO_LOG(Warning) << root.string() << ": " << without_depth << " images have no depth map within "
+                      << options.max_association_dt << " s";
   }
   const std::optional<Camera> camera = CameraInFolder(root);
   const double depth_scale = camera && camera->depth_scale > 0 ? camera->depth_scale : options.depth_scale;
@@ -170,11 +170,11 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
   Trajectory poses;
   if (fs::exists(root / "poses.txt")) poses = ReadTrajectory((root / "poses.txt").string(), TrajectoryFormat::kKitti);
   PDVO_THROW_CHECK(times.empty() || times.size() >= images.size(), FormatError,
-                   (root / "times.txt").string() << ": " << times.size() << " times for " << images.size()
-                                                 << " images");
+                   (root / "times.txt").string()
+                       << ": " << times.size() << " times for " << images.size() << " images");
   PDVO_THROW_CHECK(poses.empty() || poses.size() >= images.size(), FormatError,
-                   (root / "poses.txt").string() << ": " << poses.size() << " poses for " << images.size()
-                                                 << " images");
+                   (root / "poses.txt").string()
+                       << ": " << poses.size() << " poses for " << images.size() << " images");
 
   const cv::Mat first = ReadImage(images[0], cv::IMREAD_GRAYSCALE);
   Camera camera;
@@ -212,8 +212,7 @@ std::unique_ptr<Sequence> OpenImageFolder(const fs::path& root, const SequenceOp
   for (size_t i = 0; i < images.size(); ++i) {
     entries.push_back({times.empty() ? i / options.fps : times[i], images[i], "", std::nullopt});
   }
-  return std::make_unique<ListedSequence>("image folder", root.string(), std::move(entries), CameraInFolder(root),
-                                          1.0);
+  return std::make_unique<ListedSequence>("image folder", root.string(), std::move(entries), CameraInFolder(root), 1.0);
 }
 
 class VideoSequence : public Sequence {
@@ -246,9 +245,7 @@ class VideoSequence : public Sequence {
   }
   size_t size() const override { return count_; }
   std::optional<Camera> camera() const override { return std::nullopt; }
-  std::string Describe() const override {
-    return "video " + path_ + " (" + std::to_string(count_) + " frames)";
-  }
+  std::string Describe() const override { return "video " + path_ + " (" + std::to_string(count_) + " frames)"; }
 
  private:
   std::string path_;

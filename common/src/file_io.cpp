@@ -83,9 +83,7 @@ cv::Mat ReadImage(const std::string& path, int flags) {
   CheckNotTruncated(path, bytes);
   cv::Mat image;
   try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
-                                 const_cast<char*>(bytes.data())),
-                         flags);
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), flags);
   } catch (const cv::Exception&) {
     image.release();
   }

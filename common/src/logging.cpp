@@ -69,8 +69,7 @@ Progress::~Progress() {
 }
 
 double Progress::Rate() const {
-  const double s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   return s > 0 ? done_ / s : 0.0;
 }
 
@@ -92,8 +91,7 @@ void Progress::Finish() {
 
 void Progress::Print(bool final_line) {
   if (GetLogLevel() < LogLevel::kInfo) return;
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double rate = elapsed > 0 ? done_ / elapsed : 0.0;
   const double eta = rate > 0 && total_ > done_ ? (total_ - done_) / rate : 0.0;
   char line[320];
@@ -103,12 +101,11 @@ void Progress::Print(bool final_line) {
     const int filled = total_ ? static_cast<int>(kWidth * std::min<size_t>(done_, total_) / total_) : 0;
     std::string bar(filled, '#');
     bar.resize(kWidth, '.');
-    std::snprintf(line, sizeof(line), "\r%s [%s] %zu/%zu %.1f/s%s %s %s", what_.c_str(), bar.c_str(),
-                  done_, total_, rate, note.c_str(), final_line ? "in" : "ETA",
-                  FormatSeconds(final_line ? elapsed : eta).c_str());
+    std::snprintf(line, sizeof(line), "\r%s [%s] %zu/%zu %.1f/s%s %s %s", what_.c_str(), bar.c_str(), done_, total_,
+                  rate, note.c_str(), final_line ? "in" : "ETA", FormatSeconds(final_line ? elapsed : eta).c_str());
   } else {
-    std::snprintf(line, sizeof(line), "%s: %zu/%zu, %.1f/s%s, %s %s", what_.c_str(), done_, total_, rate,
-                  note.c_str(), final_line ? "done in" : "ETA", FormatSeconds(final_line ? elapsed : eta).c_str());
+    std::snprintf(line, sizeof(line), "%s: %zu/%zu, %.1f/s%s, %s %s", what_.c_str(), done_, total_, rate, note.c_str(),
+                  final_line ? "done in" : "ETA", FormatSeconds(final_line ? elapsed : eta).c_str());
   }
   std::lock_guard<std::mutex> lock(g_stderr_mutex);
   std::cerr << line << ((final_line || !tty_) ? "\n" : "") << std::flush;

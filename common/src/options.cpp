@@ -69,8 +69,7 @@ void ReadScalar(const cv::FileNode& node, const std::string& where, int& value) 
 }
 
 void ReadScalar(const cv::FileNode& node, const std::string& where, double& value) {
-  PDVO_THROW_CHECK(node.isInt() || node.isReal(), FormatError,
-                   where << ": expected a number, got " << TypeName(node));
+  PDVO_THROW_CHECK(node.isInt() || node.isReal(), FormatError, where << ": expected a number, got " << TypeName(node));
   value = static_cast<double>(node);
 }
 
@@ -89,9 +88,7 @@ void ReadScalar(const cv::FileNode& node, const std::string& where, std::vector<
   }
 }
 
-void WriteScalar(cv::FileStorage& fs, const char* key, const bool& value) {
-  fs << key << (value ? "true" : "false");
-}
+void WriteScalar(cv::FileStorage& fs, const char* key, const bool& value) { fs << key << (value ? "true" : "false"); }
 void WriteScalar(cv::FileStorage& fs, const char* key, const int& value) { fs << key << value; }
 void WriteScalar(cv::FileStorage& fs, const char* key, const double& value) { fs << key << value; }
 void WriteScalar(cv::FileStorage& fs, const char* key, const std::string& value) { fs << key << value; }
@@ -118,9 +115,7 @@ void ParseScalar(const std::string& text, const std::string& where, int& value) 
                    where << ": expected an integer, got '" << text << "'");
 }
 
-void ParseScalar(const std::string& text, const std::string& where, double& value) {
-  value = ParseDouble(text, where);
-}
+void ParseScalar(const std::string& text, const std::string& where, double& value) { value = ParseDouble(text, where); }
 
 void ParseScalar(const std::string& text, const std::string&, std::string& value) { value = text; }
 
@@ -131,8 +126,7 @@ void ParseScalar(const std::string& text, const std::string& where, std::vector<
   while (std::getline(ss, item, ',')) value.push_back(ParseDouble(item, where));
 }
 
-void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known,
-                        const std::string& where) {
+void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known, const std::string& where) {
   for (const std::string& key : node.keys()) {
     if (known.count(key)) continue;
     std::string list;

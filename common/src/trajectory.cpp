@@ -32,17 +32,16 @@ std::vector<Row> ReadNumericRows(const std::string& path, size_t columns) {
       row.values.push_back(v);
     }
     PDVO_THROW_CHECK(row.values.size() == columns, FormatError,
-                     path << ":" << number << ": expected " << columns << " numbers, found "
-                          << row.values.size());
+                     path << ":" << number << ": expected " << columns << " numbers, found " << row.values.size());
     rows.push_back(std::move(row));
   }
   return rows;
 }
 
 void CheckIncreasing(const std::string& path, double previous, double current, int line) {
-  PDVO_THROW_CHECK(current > previous, FormatError,
-                   path << ":" << line << ": timestamp " << current
-                        << " does not increase (previous " << previous << ")");
+  PDVO_THROW_CHECK(
+      current > previous, FormatError,
+      path << ":" << line << ": timestamp " << current << " does not increase (previous " << previous << ")");
 }
 }  // namespace
 
@@ -77,17 +76,16 @@ Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format, cons
       Eigen::Matrix<double, 3, 4> m;
       for (int i = 0; i < 12; ++i) m(i / 4, i % 4) = row.values[i];
       const Eigen::Matrix3d r = m.leftCols<3>();
-      PDVO_THROW_CHECK((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-3 &&
-                           r.determinant() > 0,
-                       FormatError,
-                       path << ":" << row.line << ": the 3x3 part is not a rotation");
+      PDVO_THROW_CHECK(
+          (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-3 && r.determinant() > 0,
+          FormatError, path << ":" << row.line << ": the 3x3 part is not a rotation");
       trajectory.push_back({static_cast<double>(trajectory.size()), Rigid3d::FromMatrix3x4(m)});
     }
     if (!times_path.empty()) {
       const std::vector<double> times = ReadTimes(times_path);
-      PDVO_THROW_CHECK(times.size() >= trajectory.size(), FormatError,
-                       times_path << ": has " << times.size() << " times but " << path << " has "
-                                  << trajectory.size() << " poses");
+      PDVO_THROW_CHECK(
+          times.size() >= trajectory.size(), FormatError,
+          times_path << ": has " << times.size() << " times but " << path << " has " << trajectory.size() << " poses");
       for (size_t i = 0; i < trajectory.size(); ++i) trajectory[i].timestamp = times[i];
     }
   }
@@ -103,8 +101,8 @@ void WriteTrajectory(const std::string& path, const Trajectory& trajectory, Traj
     const Eigen::Vector3d& t = p.world_from_cam.translation;
     if (format == TrajectoryFormat::kTum) {
       const Eigen::Quaterniond& q = p.world_from_cam.rotation;
-      std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", p.timestamp, t.x(), t.y(),
-                    t.z(), q.x(), q.y(), q.z(), q.w());
+      std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", p.timestamp, t.x(), t.y(), t.z(),
+                    q.x(), q.y(), q.z(), q.w());
     } else {
       const Eigen::Matrix<double, 3, 4> m = p.world_from_cam.ToMatrix3x4();
       int n = 0;

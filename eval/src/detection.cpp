@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
-#include "pdvo/annotations/raster.h"
 #include "compare.h"
+#include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
 
 namespace pdvo {
@@ -99,7 +99,8 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
       double best = 0;
       for (const auto& [key, inter] : overlap) {
         if (key.first != r || key.second < 0) continue;
-        best = std::max(best, static_cast<double>(inter) / static_cast<double>(ref_area[r] + det_area[key.second] - inter));
+        best = std::max(best,
+                        static_cast<double>(inter) / static_cast<double>(ref_area[r] + det_area[key.second] - inter));
       }
       covering += area * best;
     }
@@ -152,10 +153,13 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
   nlohmann::json images = nlohmann::json::array();
   for (const DetectionScore& s : scores) {
     images.push_back({{"name", s.name},
-                      {"pixels", {{"plane_as_plane", s.plane_as_plane}, {"plane_as_nonplane", s.plane_as_nonplane},
-                                  {"plane_as_none", s.plane_as_none}, {"nonplane_as_plane", s.nonplane_as_plane},
-                                  {"nonplane_as_nonplane", s.nonplane_as_nonplane},
-                                  {"nonplane_as_none", s.nonplane_as_none}}},
+                      {"pixels",
+                       {{"plane_as_plane", s.plane_as_plane},
+                        {"plane_as_nonplane", s.plane_as_nonplane},
+                        {"plane_as_none", s.plane_as_none},
+                        {"nonplane_as_plane", s.nonplane_as_plane},
+                        {"nonplane_as_nonplane", s.nonplane_as_nonplane},
+                        {"nonplane_as_none", s.nonplane_as_none}}},
                       {"reference_planes", s.reference_planes},
                       {"matched_10", s.matched_10},
                       {"matched_30", s.matched_30},
@@ -182,9 +186,9 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
                                   {"rand_index", m.rand_index},
                                   {"variation_of_information_bits", m.variation_of_information},
                                   {"covering", m.covering}};
-  const std::string how = "pixels scored where the reference annotates; planes matched by IoU >= " +
-                          std::to_string(options.match_iou) + "; plane recall over reference planes of at least " +
-                          std::to_string(options.min_plane_share) + " of the image";
+  const std::string how =
+      "pixels scored where the reference annotates; planes matched by IoU >= " + std::to_string(options.match_iou) +
+      "; plane recall over reference planes of at least " + std::to_string(options.min_plane_share) + " of the image";
   return {{"how", how}, {"summary", summary}, {"images", images}};
 }
 

@@ -58,7 +58,9 @@ RecognitionMetrics ComputeRecognitionMetrics(const std::vector<RecognitionSample
   if (!angles.empty()) {
     std::sort(angles.begin(), angles.end());
     m.normal_mean = std::accumulate(angles.begin(), angles.end(), 0.0) / angles.size();
-    auto quantile = [&](double q) { return angles[std::min(angles.size() - 1, static_cast<size_t>(q * angles.size()))]; };
+    auto quantile = [&](double q) {
+      return angles[std::min(angles.size() - 1, static_cast<size_t>(q * angles.size()))];
+    };
     m.normal_median = quantile(0.5);
     m.normal_p90 = quantile(0.9);
   }
@@ -72,9 +74,10 @@ nlohmann::json ToJson(const RecognitionMetrics& m) {
           {"precision", m.precision},
           {"recall", m.recall},
           {"roc_auc", m.roc_auc},
-          {"confusion", {{"rows", "truth plane, non-plane"},
-                         {"columns", "predicted plane, non-plane"},
-                         {"matrix", {{m.confusion[0][0], m.confusion[0][1]}, {m.confusion[1][0], m.confusion[1][1]}}}}},
+          {"confusion",
+           {{"rows", "truth plane, non-plane"},
+            {"columns", "predicted plane, non-plane"},
+            {"matrix", {{m.confusion[0][0], m.confusion[0][1]}, {m.confusion[1][0], m.confusion[1][1]}}}}},
           {"normal_error_deg",
            {{"regions", m.normals}, {"mean", m.normal_mean}, {"median", m.normal_median}, {"p90", m.normal_p90}}}};
 }

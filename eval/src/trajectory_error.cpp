@@ -23,8 +23,8 @@ std::vector<std::pair<size_t, size_t>> AssociateByTime(const Trajectory& gt, con
   std::vector<Candidate> candidates;
   for (size_t e = 0; e < est.size(); ++e) {
     const double t = est[e].timestamp;
-    const auto it = std::lower_bound(gt.begin(), gt.end(), t,
-                                     [](const StampedPose& p, double time) { return p.timestamp < time; });
+    const auto it =
+        std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& p, double time) { return p.timestamp < time; });
     const size_t hi = static_cast<size_t>(it - gt.begin());
     // Both neighbours, so that a pose taken by a closer pair still leaves its second choice.
     for (size_t g : {hi == 0 ? hi : hi - 1, hi}) {
@@ -118,8 +118,9 @@ AteResult ComputeAte(const Trajectory& gt, const Trajectory& est, Alignment alig
   for (const auto& [g, e] : pairs) {
     const Rigid3d aligned = r.gt_from_estimate * est[e].world_from_cam;
     trans.push_back((aligned.translation - gt[g].world_from_cam.translation).norm());
-    rot.push_back(AngularDistance(orientation_alignment * est[e].world_from_cam.rotation,
-                                  gt[g].world_from_cam.rotation) * 180.0 / M_PI);
+    rot.push_back(
+        AngularDistance(orientation_alignment * est[e].world_from_cam.rotation, gt[g].world_from_cam.rotation) * 180.0 /
+        M_PI);
   }
   r.translation = ComputeStats(trans);
   r.rotation_deg = ComputeStats(rot);
@@ -167,9 +168,10 @@ nlohmann::json ToJson(const AteResult& a) {
   const Eigen::Vector3d& t = a.gt_from_estimate.translation;
   return {{"matched", a.matched},
           {"scale", a.gt_from_estimate.scale},
-          {"alignment", {{"scale", a.gt_from_estimate.scale},
-                         {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
-                         {"translation", {t.x(), t.y(), t.z()}}}},
+          {"alignment",
+           {{"scale", a.gt_from_estimate.scale},
+            {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+            {"translation", {t.x(), t.y(), t.z()}}}},
           {"translation", StatsJson(a.translation)},
           {"rotation_deg", StatsJson(a.rotation_deg)}};
 }

@@ -19,7 +19,7 @@ namespace pdvo {
 namespace {
 
 constexpr double kDegree = M_PI / 180;
-constexpr double kMinProbability = 1e-3;  // MRF 1's data terms: -log of probabilities clamped to this
+constexpr double kMinProbability = 1e-3;   // MRF 1's data terms: -log of probabilities clamped to this
 constexpr double kMaxOrientationCost = 4;  // MRF 2's data cost, at most
 
 using Clock = std::chrono::steady_clock;
@@ -70,7 +70,8 @@ std::vector<std::pair<int, int>> DelaunayEdges(const std::vector<cv::Point2f>& p
   std::set<std::pair<int, int>> edges;
   for (const int e : all) {
     const int a = subdiv.edgeOrg(e), b = subdiv.edgeDst(e);
-    if (a < 0 || b < 0 || a >= static_cast<int>(point_of_vertex.size()) || b >= static_cast<int>(point_of_vertex.size()))
+    if (a < 0 || b < 0 || a >= static_cast<int>(point_of_vertex.size()) ||
+        b >= static_cast<int>(point_of_vertex.size()))
       continue;
     const int pa = point_of_vertex[a], pb = point_of_vertex[b];
     if (pa < 0 || pb < 0 || pa == pb) continue;
@@ -156,8 +157,8 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   PDVO_THROW_CHECK(!image.empty() && image.depth() == CV_8U && (image.channels() == 3 || image.channels() == 1),
                    InvalidArgument, "detector: the image must be 8-bit BGR or grey and not empty");
   PDVO_THROW_CHECK(!camera || (camera->width == image.cols && camera->height == image.rows), InvalidArgument,
-                   "detector: the image is " << image.cols << "x" << image.rows << ", its camera "
-                                             << camera->width << "x" << camera->height);
+                   "detector: the image is " << image.cols << "x" << image.rows << ", its camera " << camera->width
+                                             << "x" << camera->height);
   Detections d;
   cv::Mat work = ToWorkingSize(image, model.options.working_width, &d.scale);
   if (work.channels() == 1) cv::cvtColor(work, work, cv::COLOR_GRAY2BGR);
@@ -181,8 +182,10 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   for (const cv::Rect& box : boxes) {
     if (features.Points(box) >= model.options.min_points) kept.push_back(box);
   }
-  Eigen::MatrixXd rows(static_cast<Eigen::Index>(kept.size()), RegionFeatureDims(static_cast<int>(model.topics.cols())));
-  for (size_t k = 0; k < kept.size(); ++k) rows.row(static_cast<Eigen::Index>(k)) = features.Feature(kept[k]).transpose();
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(kept.size()),
+                       RegionFeatureDims(static_cast<int>(model.topics.cols())));
+  for (size_t k = 0; k < kept.size(); ++k)
+    rows.row(static_cast<Eigen::Index>(k)) = features.Feature(kept[k]).transpose();
   const std::vector<RegionPrediction> predictions = recogniser_.PredictRows(rows);
   for (size_t k = 0; k < kept.size(); ++k) {
     const Region region{kept[k], cv::Mat()};
@@ -266,7 +269,6 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     for (size_t p = 0; p < planar.size(); ++p) d.orientation[planar[p]] = labels[p];
   }
   d.times.segmentation = Ms(t);
-
 
   // 4. Segments: their areas (Voronoi cells within cell_radius), recognised again.
   t = Clock::now();

@@ -40,7 +40,8 @@ Eigen::MatrixXd ReadMatrix(const cv::FileNode& node, const std::string& where, c
 // `name` empty: an element of a sequence.
 void WriteRvm(cv::FileStorage& fs, const std::string& name, const RvmFunction& f) {
   if (!name.empty()) fs << name;
-  fs << "{" << "gamma" << f.gamma << "bias" << f.bias << "relevance_vectors" << f.size();
+  fs << "{"
+     << "gamma" << f.gamma << "bias" << f.bias << "relevance_vectors" << f.size();
   fs << "weights" << ToMat(f.weights) << "vectors" << ToFloatMat(f.vectors) << "}";
 }
 
@@ -73,7 +74,8 @@ Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
   Eigen::MatrixXd distance = -2.0 * rows * vectors.transpose();
   distance.colwise() += rows.rowwise().squaredNorm();
   distance.rowwise() += vectors.rowwise().squaredNorm().transpose();
-  return (-gamma * distance.cwiseMax(0.0)).array().exp().matrix() * weights - Eigen::VectorXd::Constant(rows.rows(), bias);
+  return (-gamma * distance.cwiseMax(0.0)).array().exp().matrix() * weights -
+         Eigen::VectorXd::Constant(rows.rows(), bias);
 }
 
 bool RecogniserOptions::Check() const {
@@ -89,18 +91,20 @@ std::string PlaneModel::ToYaml() const {
   // Matrices in base64 (raw bytes: a third of the size of their text, and exactly the same values).
   cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::BASE64);
   fs << "format" << kModelFormat << "version" << kModelVersion;
-  fs << "options" << "{";
+  fs << "options"
+     << "{";
   WriteOptions(fs, options);
   fs << "}";
-  fs << "card" << "{" << "data" << card.data << "images" << card.images << "plane_regions" << card.plane_regions
-     << "non_plane_regions" << card.non_plane_regions << "normal_regions" << card.normal_regions << "folds"
-     << card.folds << "cv_accuracy" << card.cv_accuracy << "cv_normal_error_deg" << card.cv_normal_error << "seed"
-     << card.seed << "}";
+  fs << "card"
+     << "{"
+     << "data" << card.data << "images" << card.images << "plane_regions" << card.plane_regions << "non_plane_regions"
+     << card.non_plane_regions << "normal_regions" << card.normal_regions << "folds" << card.folds << "cv_accuracy"
+     << card.cv_accuracy << "cv_normal_error_deg" << card.cv_normal_error << "seed" << card.seed << "}";
   gradient_words.Write(fs, "gradient_words");
   colour_words.Write(fs, "colour_words");
-  fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale"
-     << ToMat(feature_scale);
-  fs << "classifiers" << "[";
+  fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale" << ToMat(feature_scale);
+  fs << "classifiers"
+     << "[";
   for (const RvmFunction& f : classifiers) WriteRvm(fs, "", f);
   fs << "]";
   WriteRvm(fs, "normal_x", normal[0]);

@@ -95,15 +95,16 @@ std::vector<int> BinaryEnergy::Minimise(double* energy) const {
 }
 
 double PottsEnergy(const Eigen::MatrixXd& unary, const std::vector<PottsEdge>& edges, const std::vector<int>& x) {
-  PDVO_THROW_CHECK(static_cast<Eigen::Index>(x.size()) == unary.rows(), InvalidArgument, "Potts energy: labelling size");
+  PDVO_THROW_CHECK(static_cast<Eigen::Index>(x.size()) == unary.rows(), InvalidArgument,
+                   "Potts energy: labelling size");
   double e = 0;
   for (size_t i = 0; i < x.size(); ++i) e += unary(static_cast<Eigen::Index>(i), x[i]);
   for (const PottsEdge& edge : edges) e += x[edge.a] != x[edge.b] ? edge.weight : 0.0;
   return e;
 }
 
-std::vector<int> AlphaExpansion(const Eigen::MatrixXd& unary, const std::vector<PottsEdge>& edges,
-                                std::vector<int> x, int max_sweeps) {
+std::vector<int> AlphaExpansion(const Eigen::MatrixXd& unary, const std::vector<PottsEdge>& edges, std::vector<int> x,
+                                int max_sweeps) {
   const int n = static_cast<int>(unary.rows()), labels = static_cast<int>(unary.cols());
   PDVO_THROW_CHECK(static_cast<int>(x.size()) == n && unary.allFinite(), InvalidArgument,
                    "alpha-expansion: " << x.size() << " initial labels for " << n << " nodes, or non-finite costs");

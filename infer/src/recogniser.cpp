@@ -39,8 +39,7 @@ cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale) {
   return out;
 }
 
-RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words,
-                               int colour_words) {
+RegionWords CollectRegionWords(const ImageWords& words, const Region& region, int gradient_words, int colour_words) {
   RegionWords r;
   r.box = cv::Rect2d(region.box.x - 0.5, region.box.y - 0.5, region.box.width, region.box.height);
   r.image_size = words.image_size;
@@ -137,8 +136,8 @@ AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int workin
 }
 
 Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
-  PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(),
-                   InvalidArgument, "recogniser: the topic basis does not match the vocabularies");
+  PDVO_THROW_CHECK(model_.topics.rows() == model_.gradient_words.size() + model_.colour_words.size(), InvalidArgument,
+                   "recogniser: the topic basis does not match the vocabularies");
   const Eigen::Index dims = RegionFeatureDims(static_cast<int>(model_.topics.cols()));
   PDVO_THROW_CHECK(!model_.classifiers.empty(), InvalidArgument, "recogniser: the model has no classifier");
   const bool classifiers_fit =

@@ -87,9 +87,8 @@ std::vector<DirectionMode> MeanShiftModes(const std::vector<Eigen::Vector3d>& d,
     }
     out[nearest].support += w[i];
   }
-  std::stable_sort(out.begin(), out.end(), [](const DirectionMode& a, const DirectionMode& b) {
-    return a.support > b.support;
-  });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const DirectionMode& a, const DirectionMode& b) { return a.support > b.support; });
   return out;
 }
 

@@ -12,9 +12,9 @@ Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::Mat
                                   const Eigen::VectorXd& histogram, int iterations) {
   PDVO_THROW_CHECK(gram.rows() == basis.cols() && gram.cols() == basis.cols(), InvalidArgument,
                    "topic projection: a Gram matrix of the wrong size");
-  PDVO_THROW_CHECK(basis.rows() == histogram.size(), InvalidArgument,
-                   "topic projection: the basis has " << basis.rows() << " words but the histogram "
-                                                      << histogram.size());
+  PDVO_THROW_CHECK(
+      basis.rows() == histogram.size(), InvalidArgument,
+      "topic projection: the basis has " << basis.rows() << " words but the histogram " << histogram.size());
   PDVO_THROW_CHECK(basis.minCoeff() >= 0 && histogram.minCoeff() >= 0, InvalidArgument,
                    "topic projection: basis and histogram must be non-negative");
   constexpr double kEpsilon = 1e-12;

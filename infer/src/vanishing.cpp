@@ -43,8 +43,7 @@ EdgePlanes FindEdgePlanes(const cv::Mat& image, const std::optional<Camera>& cam
   k.Check("edge planes");
   PDVO_THROW_CHECK(!k.HasDistortion() && k.width == image.cols && k.height == image.rows, InvalidArgument,
                    "edge planes: the camera (" << k.width << "x" << k.height << (k.HasDistortion() ? ", distorted" : "")
-                                               << ") does not fit the " << image.cols << "x" << image.rows
-                                               << " image");
+                                               << ") does not fit the " << image.cols << "x" << image.rows << " image");
   EdgePlanes e;
   e.camera = k;
   cv::Mat grey = image;
@@ -166,8 +165,7 @@ double AzimuthLikelihood::Phi(const Eigen::Vector3d& n) const {
   return phi >= M_PI ? phi - M_PI : phi;
 }
 
-AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region,
-                                          const VanishingOptions& o) {
+AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region, const VanishingOptions& o) {
   AzimuthLikelihood l;
   l.up = edges.up;
   l.e1 = (Eigen::Vector3d::UnitX() - edges.up.x() * edges.up).normalized();

@@ -54,7 +54,9 @@ WindowFeatures::WindowFeatures(const ImageWords& words, const PlaneModel& model,
   const int words_at = 1, topics_at = 1 + g + c, bins_at = topics_at + kMoments * topics;
   const int families_at = bins_at + kMoments * kOrientationBins;
   table_.assign(static_cast<size_t>(rows_ + 1) * (columns_ + 1) * channels_, 0.0);
-  auto at = [&](int row, int column) { return &table_[(static_cast<size_t>(row) * (columns_ + 1) + column) * channels_]; };
+  auto at = [&](int row, int column) {
+    return &table_[(static_cast<size_t>(row) * (columns_ + 1) + column) * channels_];
+  };
   for (size_t i = 0; i < words.size(); ++i) {
     const cv::Point2f& p = words.points[i];
     const cv::Point pixel = NearestPixel(p);
@@ -93,7 +95,8 @@ WindowFeatures::WindowFeatures(const ImageWords& words, const PlaneModel& model,
   for (int row = 0; row < rows_; ++row) {
     for (int column = 0; column < columns_; ++column) {
       const double* from = at(row + 1, column + 1) + topics_at;
-      std::copy(from, from + topic_channels, &topic_cells_[(static_cast<size_t>(row) * columns_ + column) * topic_channels]);
+      std::copy(from, from + topic_channels,
+                &topic_cells_[(static_cast<size_t>(row) * columns_ + column) * topic_channels]);
     }
   }
   for (int row = 1; row <= rows_; ++row) {
@@ -164,8 +167,7 @@ Eigen::VectorXd WindowFeatures::Feature(const cv::Rect& box) const {
   const Eigen::Vector2d half(edges.width / 2, edges.height / 2);
   Eigen::VectorXd histogram = s.segment(1, g + c);
   if (n > 0) histogram /= 2.0 * n;
-  const Eigen::VectorXd weights =
-      ProjectOntoTopics(model_.topics, gram_, histogram, model_.options.topic_iterations);
+  const Eigen::VectorXd weights = ProjectOntoTopics(model_.topics, gram_, histogram, model_.options.topic_iterations);
   Eigen::VectorXd feature(RegionFeatureDims(topics));
   for (int t = 0; t < topics; ++t) {
     MomentsToSpatiogram(weights[t], s.data() + topics_at + kMoments * t, centre, half, feature.data() + kMoments * t);

@@ -32,7 +32,8 @@ class Painter {
   Painter(cv::Mat* image, double tpm, double height) : image_(image), tpm_(tpm), height_(height) {}
   cv::Rect Rect(double u0, double v0, double u1, double v1) const {
     const int x0 = static_cast<int>(std::floor(u0 * tpm_)), x1 = static_cast<int>(std::ceil(u1 * tpm_));
-    const int y0 = static_cast<int>(std::floor((height_ - v1) * tpm_)), y1 = static_cast<int>(std::ceil((height_ - v0) * tpm_));
+    const int y0 = static_cast<int>(std::floor((height_ - v1) * tpm_)),
+              y1 = static_cast<int>(std::ceil((height_ - v0) * tpm_));
     return cv::Rect(x0, y0, std::max(1, x1 - x0), std::max(1, y1 - y0));
   }
   void Fill(double u0, double v0, double u1, double v1, const cv::Scalar& colour) {
@@ -77,7 +78,8 @@ void PaintWall(Material material, Painter& p, const cv::Size& size, double width
     int row = 0;
     for (double v = 0; v < height; v += 0.075, ++row) {
       for (double x = (row % 2) * -0.11; x < width; x += 0.23) {
-        p.Fill(std::max(0.0, x), v + 0.01, x + 0.22, v + 0.075, Bgr(jitter(b0 * 0.5, 0.2), jitter(g0, 0.2), jitter(r0, 0.15)));
+        p.Fill(std::max(0.0, x), v + 0.01, x + 0.22, v + 0.075,
+               Bgr(jitter(b0 * 0.5, 0.2), jitter(g0, 0.2), jitter(r0, 0.15)));
       }
     }
   } else if (material == Material::kStone) {
@@ -94,7 +96,8 @@ void PaintWall(Material material, Painter& p, const cv::Size& size, double width
     const cv::Scalar colour = Bgr(0.5 + 0.45 * u(rng), 0.5 + 0.45 * u(rng), 0.5 + 0.45 * u(rng));
     p.Fill(0, 0, width, height, colour);
     cv::Mat blotch(std::max(2, size.height / 40), std::max(2, size.width / 40), CV_32F);
-    for (int i = 0; i < static_cast<int>(blotch.total()); ++i) blotch.at<float>(i) = static_cast<float>(0.9 + 0.2 * u(rng));
+    for (int i = 0; i < static_cast<int>(blotch.total()); ++i)
+      blotch.at<float>(i) = static_cast<float>(0.9 + 0.2 * u(rng));
     cv::resize(blotch, blotch, size, 0, 0, cv::INTER_CUBIC);
     p.Modulate(blotch);
   }
@@ -110,7 +113,8 @@ void PaintWindow(Painter& p, double u0, double v0, double w, double h, std::mt19
   const double tint = 0.3 + 0.3 * u(rng);
   for (int k = 0; k < bands; ++k) {
     const double f = static_cast<double>(k) / bands;
-    p.Fill(u0, v0 + h * f, u0 + w, v0 + h * (f + 1.0 / bands), Bgr(0.35 + tint * f, 0.3 + 0.6 * tint * f, 0.25 + 0.4 * tint * f));
+    p.Fill(u0, v0 + h * f, u0 + w, v0 + h * (f + 1.0 / bands),
+           Bgr(0.35 + tint * f, 0.3 + 0.6 * tint * f, 0.25 + 0.4 * tint * f));
   }
   p.Fill(u0 + w * 0.15, v0 + h * 0.55, u0 + w * 0.3, v0 + h * 0.9, Bgr(0.85, 0.82, 0.8));
   p.Fill(u0 + w / 2 - 0.03, v0, u0 + w / 2 + 0.03, v0 + h, frame);  // mullion
@@ -155,7 +159,8 @@ cv::Mat MakeTexture(const WorldPlane& plane, double tpm) {
       const double across = plane.width;
       p.Fill(0.25, 0, 0.37, plane.height, Bgr(0.85, 0.85, 0.85));
       p.Fill(across - 0.37, 0, across - 0.25, plane.height, Bgr(0.85, 0.85, 0.85));
-      for (double v = 1.0; v < plane.height; v += 6.0) p.Fill(across / 2 - 0.06, v, across / 2 + 0.06, v + 3.0, Bgr(0.9, 0.9, 0.9));
+      for (double v = 1.0; v < plane.height; v += 6.0)
+        p.Fill(across / 2 - 0.06, v, across / 2 + 0.06, v + 3.0, Bgr(0.9, 0.9, 0.9));
       return t;
     }
     case Material::kPavement: {
@@ -191,7 +196,8 @@ Eigen::Vector3d BlobNormal(const WorldBlob& b, const Eigen::Vector3d& x) {
 }
 
 uint32_t Hash(int x, int y, int z) {
-  uint32_t h = static_cast<uint32_t>(x) * 73856093u ^ static_cast<uint32_t>(y) * 19349663u ^ static_cast<uint32_t>(z) * 83492791u;
+  uint32_t h = static_cast<uint32_t>(x) * 73856093u ^ static_cast<uint32_t>(y) * 19349663u ^
+               static_cast<uint32_t>(z) * 83492791u;
   h ^= h >> 13;
   h *= 0x5bd1e995u;
   return h ^ (h >> 15);
@@ -207,7 +213,8 @@ Renderer::Renderer(const Street& street, const Camera& camera, const RenderOptio
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   const double azimuth = 2 * M_PI * u(rng), elevation = (35 + 25 * u(rng)) * M_PI / 180;
-  sun_ = Eigen::Vector3d(std::cos(elevation) * std::sin(azimuth), -std::sin(elevation), std::cos(elevation) * std::cos(azimuth));
+  sun_ = Eigen::Vector3d(std::cos(elevation) * std::sin(azimuth), -std::sin(elevation),
+                         std::cos(elevation) * std::cos(azimuth));
   exposure_phase_ = 2 * M_PI * u(rng);
   for (const WorldPlane& p : street.planes) {
     textures_.push_back(MakeTexture(p, options.texels_per_metre));
@@ -240,7 +247,8 @@ void Renderer::RenderGeometry(const Rigid3d& world_from_cam, RenderedFrame* out)
     clipped.clear();
     const size_t m = plane.polygon.size();
     for (size_t k = 0; k < m; ++k) {
-      const Eigen::Vector3d a = cam_from_world * (plane.polygon[k] - c), b = cam_from_world * (plane.polygon[(k + 1) % m] - c);
+      const Eigen::Vector3d a = cam_from_world * (plane.polygon[k] - c),
+                            b = cam_from_world * (plane.polygon[(k + 1) % m] - c);
       if (a.z() >= kNear) clipped.push_back(a);
       if ((a.z() >= kNear) != (b.z() >= kNear)) clipped.push_back(a + (b - a) * ((kNear - a.z()) / (b.z() - a.z())));
     }
@@ -252,7 +260,8 @@ void Renderer::RenderGeometry(const Rigid3d& world_from_cam, RenderedFrame* out)
       y_min = std::min(y_min, projected.back().y());
       y_max = std::max(y_max, projected.back().y());
     }
-    const int row0 = std::max(0, static_cast<int>(std::ceil(y_min))), row1 = std::min(h - 1, static_cast<int>(std::floor(y_max)));
+    const int row0 = std::max(0, static_cast<int>(std::ceil(y_min))),
+              row1 = std::min(h - 1, static_cast<int>(std::floor(y_max)));
     for (int v = row0; v <= row1; ++v) {
       double x_lo = 1e18, x_hi = -1e18;
       for (size_t k = 0; k < projected.size(); ++k) {
@@ -266,7 +275,8 @@ void Renderer::RenderGeometry(const Rigid3d& world_from_cam, RenderedFrame* out)
         x_lo = std::min(x_lo, x);
         x_hi = std::max(x_hi, x);
       }
-      const int col0 = std::max(0, static_cast<int>(std::ceil(x_lo))), col1 = std::min(w - 1, static_cast<int>(std::floor(x_hi)));
+      const int col0 = std::max(0, static_cast<int>(std::ceil(x_lo))),
+                col1 = std::min(w - 1, static_cast<int>(std::floor(x_hi)));
       const double row_term = n.y() * ray_y_[v] + n.z();
       for (int u = col0; u <= col1; ++u) {
         const double inv = -(n.x() * ray_x_[u] + row_term) / d_cam;
@@ -379,7 +389,8 @@ void Renderer::Shade(const Rigid3d& world_from_cam, const RenderedFrame& g, cv::
       } else if (id == kSkyId) {
         const Eigen::Vector3d dir = (r_wc * ray).normalized();
         const double up = std::sqrt(std::max(0.0, -dir.y()));
-        out[u] += cv::Vec3f(static_cast<float>(235 - 30 * up), static_cast<float>(215 - 70 * up), static_cast<float>(195 - 110 * up));
+        out[u] += cv::Vec3f(static_cast<float>(235 - 30 * up), static_cast<float>(215 - 70 * up),
+                            static_cast<float>(195 - 110 * up));
       } else {
         const WorldBlob& b = street_.blobs[-2 - id];
         const Eigen::Vector3d x = c + r_wc * (depth[u] * ray);
@@ -390,10 +401,15 @@ void Renderer::Shade(const Rigid3d& world_from_cam, const RenderedFrame& g, cv::
                                     static_cast<int>(std::floor(x.z() * 14)));
           texture = 0.55 + 0.8 * (hsh & 1023) / 1023.0;
         } else if (b.material == Material::kBark) {
-          texture = 0.8 + 0.4 * (Hash(0, static_cast<int>(std::floor(x.y() * 20)), static_cast<int>(std::atan2(x.z() - b.centre.z(), x.x() - b.centre.x()) * 8)) & 255) / 255.0;
+          texture = 0.8 + 0.4 *
+                              (Hash(0, static_cast<int>(std::floor(x.y() * 20)),
+                                    static_cast<int>(std::atan2(x.z() - b.centre.z(), x.x() - b.centre.x()) * 8)) &
+                               255) /
+                              255.0;
         }
         const double k = 255 * light * texture;
-        out[u] += cv::Vec3f(static_cast<float>(b.colour.x() * k), static_cast<float>(b.colour.y() * k), static_cast<float>(b.colour.z() * k));
+        out[u] += cv::Vec3f(static_cast<float>(b.colour.x() * k), static_cast<float>(b.colour.y() * k),
+                            static_cast<float>(b.colour.z() * k));
       }
     }
   }

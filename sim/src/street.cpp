@@ -205,8 +205,8 @@ void StreetBuilder::AddClutter(size_t i, int side) {
     if (Chance(0.4) && t + o_.tree_spacing / 2 < length - 3) {  // bushes stay on their own segment
       const Eigen::Vector3d bush = along(t + o_.tree_spacing / 2, half + o_.pavement_width - 0.5, 0.35);
       for (int k = 0; k < 3; ++k) {
-        AddBlob(WorldBlob::Kind::kEllipsoid, Material::kLeaves, bush + Eigen::Vector3d(Uniform(-0.5, 0.5), 0, Uniform(-0.5, 0.5)),
-                {0.5, 0.4, 0.5}, 0, green * 0.8);
+        AddBlob(WorldBlob::Kind::kEllipsoid, Material::kLeaves,
+                bush + Eigen::Vector3d(Uniform(-0.5, 0.5), 0, Uniform(-0.5, 0.5)), {0.5, 0.4, 0.5}, 0, green * 0.8);
       }
     }
   }
@@ -270,8 +270,8 @@ Street StreetBuilder::Build(double min_length) {
     }
   }
   if (!o_.loop) {
-    AddEndWall(0, Direction(0));                            // behind the start, facing along the street
-    AddEndWall(Count() - 1, -Direction(Count() - 2));       // beyond the end, facing back
+    AddEndWall(0, Direction(0));                       // behind the start, facing along the street
+    AddEndWall(Count() - 1, -Direction(Count() - 2));  // beyond the end, facing back
   }
   return std::move(street_);
 }

@@ -119,7 +119,8 @@ void WriteSynthSequence(const std::string& out_dir, uint64_t seed, int frames, c
   SaveOptions(out.path("synth.yaml"), options, "synth");
   camera.Write(out.path("camera.yaml"));
   WriteFileAtomically(out.path("planes.json"), PlanesJson(street).dump(1) + "\n");
-  std::string rgb_list = "# color images\n# timestamp filename\n", depth_list = "# depth maps (2000 per metre, see camera.yaml)\n# timestamp filename\n";
+  std::string rgb_list = "# color images\n# timestamp filename\n",
+              depth_list = "# depth maps (2000 per metre, see camera.yaml)\n# timestamp filename\n";
   RenderedFrame frame;
   cv::Mat depth16, ids16;
   for (int i = 0; i < frames; ++i) {

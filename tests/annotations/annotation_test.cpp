@@ -164,7 +164,8 @@ TEST(Annotation, WarningsForUnknownLabelsAndNonUnitNormals) {
   EXPECT_FALSE(issues[0].is_error);
   EXPECT_EQ(issues[0].message, "normal is not unit length (it is normalised)");
   EXPECT_FALSE(issues[1].is_error);
-  EXPECT_EQ(FormatIssue(issues[1], a, "f.json"), "f.json: shape 1 (tree): unknown label 'tree' (ignored; use plane or non-plane)");
+  EXPECT_EQ(FormatIssue(issues[1], a, "f.json"),
+            "f.json: shape 1 (tree): unknown label 'tree' (ignored; use plane or non-plane)");
   EXPECT_NO_THROW(ValidateOrThrow(a, "f.json"));
   a.shapes[0].normal = Eigen::Vector3d(0, 0, 1);
   try {

@@ -31,7 +31,8 @@ Recovered Recover(const Annotation& a, const test::RenderedDepth& truth, int id,
     const cv::Mat mask = RasteriseShape(s, a);
     if (cv::countNonZero(mask & want) < 0.5 * cv::countNonZero(mask)) continue;
     got |= mask & ~near_bush;
-    r.worst_angle_deg = std::max(r.worst_angle_deg, std::acos(std::clamp(s.normal->dot(normal), -1.0, 1.0)) * 180 / M_PI);
+    r.worst_angle_deg =
+        std::max(r.worst_angle_deg, std::acos(std::clamp(s.normal->dot(normal), -1.0, 1.0)) * 180 / M_PI);
   }
   r.iou = cv::countNonZero(want & got) / static_cast<double>(cv::countNonZero(want | got));
   return r;
@@ -69,7 +70,8 @@ TEST(DepthPlanes, PlaneParametersMatchTheTruthWithoutNoise) {
   ASSERT_EQ(found.size(), 3u);
   for (const DepthPlane& f : found) {
     double best = 1e9;
-    for (const auto& p : planes) best = std::min(best, (f.normal - p.normal).norm() + std::abs(f.distance - p.distance));
+    for (const auto& p : planes)
+      best = std::min(best, (f.normal - p.normal).norm() + std::abs(f.distance - p.distance));
     EXPECT_LT(best, 1e-4);
   }
 }

@@ -12,7 +12,7 @@ namespace {
 Annotation TwoShapes() {
   return test::ImageAnnotation("x.png", 200, 100,
                                {test::RectShape(kPlaneLabel, 10, 10, 89, 89, Eigen::Vector3d(0.6, 0, -0.8)),  // 80x80
-                                test::RectShape(kNonPlaneLabel, 120, 20, 159, 59),                          // 40x40
+                                test::RectShape(kNonPlaneLabel, 120, 20, 159, 59),                            // 40x40
                                 test::Shape("sky", {{0, 0}, {199, 0}, {199, 5}})});
 }
 

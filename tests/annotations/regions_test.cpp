@@ -13,7 +13,8 @@ namespace {
 Annotation Scene() {
   return test::ImageAnnotation(
       "x.png", 400, 200,
-      {test::Shape(kPlaneLabel, {{0, 0}, {199, 0}, {199, 79}, {79, 79}, {79, 199}, {0, 199}}, Eigen::Vector3d(0, 0, -1)),
+      {test::Shape(kPlaneLabel, {{0, 0}, {199, 0}, {199, 79}, {79, 79}, {79, 199}, {0, 199}},
+                   Eigen::Vector3d(0, 0, -1)),
        test::RectShape(kNonPlaneLabel, 250, 50, 349, 149), test::Shape("sky", {{200, 0}, {399, 0}, {399, 20}})});
 }
 

@@ -78,8 +78,7 @@ TEST(Cli, UsageAndHelp) {
   EXPECT_EQ(help.code, 0);
   EXPECT_NE(help.out.find("annotate-depth"), std::string::npos);
   EXPECT_EQ(Pdvo("frobnicate", dir).code, 1);
-  for (const char* command :
-       {"show", "validate", "annotate-depth", "compare", "ate", "detect", "evaluate-detection"}) {
+  for (const char* command : {"show", "validate", "annotate-depth", "compare", "ate", "detect", "evaluate-detection"}) {
     const CommandResult r = Pdvo(std::string(command) + " --help", dir);
     EXPECT_EQ(r.code, 0) << command;
     EXPECT_NE(r.out.find("--verbosity"), std::string::npos) << command;
@@ -121,7 +120,8 @@ TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {
   WriteFileAtomically(dir / "gt.txt", "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n3 2 0 0 0 0 0 1\n");
   WriteFileAtomically(dir / "back.txt", "1 0 0 0 0 0 0 1\n0.5 1 0 0 0 0 0 1\n");
   expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "empty.txt"), "empty.txt: contains no poses");
-  expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "back.txt"), "back.txt:2: timestamp 0.5 does not increase");
+  expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "back.txt"),
+               "back.txt:2: timestamp 0.5 does not increase");
   expect_error("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "gt.txt") + " --align affine", "unknown alignment");
 
   WriteRoomSequence(dir / "seq");
@@ -136,15 +136,16 @@ TEST(Cli, AteOfAScaledCopy) {
   test::TempDir dir;
   Trajectory gt;
   for (int i = 0; i < 50; ++i) {
-    gt.push_back({i * 0.1, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.02 * i, 0)), Eigen::Vector3d(std::sin(0.1 * i), 0.05 * i, i * 0.1))});
+    gt.push_back({i * 0.1, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.02 * i, 0)),
+                                   Eigen::Vector3d(std::sin(0.1 * i), 0.05 * i, i * 0.1))});
   }
   Trajectory est = gt;
   for (StampedPose& p : est) p.world_from_cam.translation *= 0.25;
   WriteTrajectory(dir / "gt.txt", gt, TrajectoryFormat::kTum);
   WriteTrajectory(dir / "est.txt", est, TrajectoryFormat::kTum);
-  const CommandResult r = Pdvo("ate --gt " + (dir / "gt.txt") + " --est " + (dir / "est.txt") + " --align sim3 --json " +
-                         (dir / "ate.json"),
-                     dir);
+  const CommandResult r = Pdvo(
+      "ate --gt " + (dir / "gt.txt") + " --est " + (dir / "est.txt") + " --align sim3 --json " + (dir / "ate.json"),
+      dir);
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(ReadFile(dir / "ate.json"));
   EXPECT_NEAR(j["ate"]["scale"].get<double>(), 4.0, 1e-6);
@@ -213,8 +214,7 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   EXPECT_GT(fs::file_size(dir / "out/overlay.avi"), 1000u);
 
   const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
-  expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"),
-               "gone.yaml");
+  expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"), "gone.yaml");
   fs::create_directories(dir / "empty");
   expect_error("vo -v warning -s " + (dir / "empty") + " -o " + (dir / "o2"), "empty");
   {
@@ -251,9 +251,11 @@ TEST(Cli, DetectWritesAnnotationsAndRefusesBadInput) {
   }
   EXPECT_GT(planes, 0);
   EXPECT_TRUE(fs::exists(dir / "det/detector.yaml"));
-  ASSERT_EQ(Pdvo("detect -m " + model + " " + (dir / "s/rgb/000001.png") + " -c " + (dir / "s/camera.yaml") +
-                     " -o " + (dir / "one") + " -v warning",
-                 dir).code, 0);
+  ASSERT_EQ(Pdvo("detect -m " + model + " " + (dir / "s/rgb/000001.png") + " -c " + (dir / "s/camera.yaml") + " -o " +
+                     (dir / "one") + " -v warning",
+                 dir)
+                .code,
+            0);
   EXPECT_EQ(ReadFile(dir / "one/000001.json"), ReadFile(dir / "det/000001.json"));
 
   const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
@@ -263,9 +265,9 @@ TEST(Cli, DetectWritesAnnotationsAndRefusesBadInput) {
   expect_error("detect -v warning -m " + (dir / "s/camera.yaml") + " " + (dir / "s") + " -o " + (dir / "o3"),
                "camera.yaml");
   cv::imwrite(dir / "tiny.png", cv::Mat(20, 20, CV_8UC3, cv::Scalar(0, 0, 0)));
-  expect_error("detect -v warning -m " + model + " " + (dir / "tiny.png") + " -o " + (dir / "o4") +
-                   " --set window_sizes=400",
-               "smaller than the smallest window");
+  expect_error(
+      "detect -v warning -m " + model + " " + (dir / "tiny.png") + " -o " + (dir / "o4") + " --set window_sizes=400",
+      "smaller than the smallest window");
   for (const char* o : {"o1", "o2", "o3", "o4"}) EXPECT_FALSE(fs::exists(dir / o)) << o << ": no partial output";
 }
 
@@ -360,8 +362,8 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
   cv::randu(image, 0, 255);
   fs::create_directories(dir / "planes");
   WriteImage(dir / "planes/img.png", image);
-  Annotation a =
-      test::ImageAnnotation("img.png", 160, 120, {test::RectShape(kPlaneLabel, 5, 5, 150, 110, Eigen::Vector3d(0, 0, -1))});
+  Annotation a = test::ImageAnnotation("img.png", 160, 120,
+                                       {test::RectShape(kPlaneLabel, 5, 5, 150, 110, Eigen::Vector3d(0, 0, -1))});
   WriteAnnotation(dir / "planes/a.json", a);
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set recogniser.working_width=0 -v error",
                "no non-plane regions");

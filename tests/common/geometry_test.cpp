@@ -79,8 +79,8 @@ TEST(Geometry, NearestRotation) {
   perturbed(0, 1) += 1e-3;
   EXPECT_LT((NearestRotation(perturbed) - r).cwiseAbs().maxCoeff(), 1e-3);
   EXPECT_NEAR(NearestRotation(-Eigen::Matrix3d::Identity()).determinant(), 1.0, 1e-12);
-  const Eigen::Matrix3d sum = ExpSO3(Eigen::Vector3d(0, 0, 0.1)).toRotationMatrix() +
-                              ExpSO3(Eigen::Vector3d(0, 0, 0.3)).toRotationMatrix();
+  const Eigen::Matrix3d sum =
+      ExpSO3(Eigen::Vector3d(0, 0, 0.1)).toRotationMatrix() + ExpSO3(Eigen::Vector3d(0, 0, 0.3)).toRotationMatrix();
   EXPECT_LT((NearestRotation(sum) - ExpSO3(Eigen::Vector3d(0, 0, 0.2)).toRotationMatrix()).cwiseAbs().maxCoeff(),
             1e-12);
 }

@@ -49,7 +49,7 @@ TEST(Progress, CountsStepsAndPrintsPlainLinesWhenNotOnATerminal) {
     EXPECT_GT(progress.Rate(), 0.0);
   }
   const std::string err = testing::internal::GetCapturedStderr();
-  EXPECT_NE(err.find("work: 4/4"), std::string::npos) << err;  // the final line, printed once
+  EXPECT_NE(err.find("work: 4/4"), std::string::npos) << err;    // the final line, printed once
   EXPECT_NE(err.find(", state 30,"), std::string::npos) << err;  // with the latest note
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1);
   SetLogLevel(before);

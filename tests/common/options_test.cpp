@@ -116,9 +116,7 @@ TEST(Options, AFailedCheckNamesTheValuesOfWholeNamesOnly) {
   EXPECT_FALSE(detail::MentionsIdentifier("iterations2 > 0", "iterations"));
 }
 
-TEST(Options, MissingFileIsAnIoError) {
-  EXPECT_THROW(LoadOptions<OuterOptions>("/nonexistent/o.yaml"), IoError);
-}
+TEST(Options, MissingFileIsAnIoError) { EXPECT_THROW(LoadOptions<OuterOptions>("/nonexistent/o.yaml"), IoError); }
 
 TEST(Options, OverridesSetNestedFields) {
   OuterOptions o;

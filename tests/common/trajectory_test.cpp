@@ -80,8 +80,7 @@ TEST(Trajectory, BadFilesGiveOneLineErrorsWithFileAndLine) {
   EXPECT_NE(ErrorOf("1 0 nan 0 0 0 0 1\n").find("not finite"), std::string::npos);
   EXPECT_NE(ErrorOf("1 0 x 0 0 0 0 1\n").find("'x' is not a number"), std::string::npos);
   EXPECT_NE(ErrorOf("1 0 0 0 0 0 0 0\n").find("zero quaternion"), std::string::npos);
-  EXPECT_NE(ErrorOf("1 0 0 0 0 1 0 0 0 0 0 0\n", TrajectoryFormat::kKitti).find("not a rotation"),
-            std::string::npos);
+  EXPECT_NE(ErrorOf("1 0 0 0 0 1 0 0 0 0 0 0\n", TrajectoryFormat::kKitti).find("not a rotation"), std::string::npos);
   EXPECT_THROW(ReadTrajectory("/nonexistent.txt", TrajectoryFormat::kTum), IoError);
   EXPECT_THROW(ParseTrajectoryFormat("euroc"), InvalidArgument);
 }

@@ -53,8 +53,8 @@ TEST(Recognition, NormalErrorsOverPlanesWithReferenceNormals) {
     const double r = deg * M_PI / 180;
     s.push_back({true, 0.9, truth, Eigen::Vector3d(std::sin(r), 0, -std::cos(r))});
   }
-  s.push_back({true, 0.9, std::nullopt, Eigen::Vector3d(1, 0, 0)});   // no reference: not counted
-  s.push_back({false, 0.1, truth, Eigen::Vector3d(1, 0, 0)});         // non-plane: not counted
+  s.push_back({true, 0.9, std::nullopt, Eigen::Vector3d(1, 0, 0)});  // no reference: not counted
+  s.push_back({false, 0.1, truth, Eigen::Vector3d(1, 0, 0)});        // non-plane: not counted
   const RecognitionMetrics m = ComputeRecognitionMetrics(s);
   EXPECT_EQ(m.normals, 10);
   EXPECT_NEAR(m.normal_mean, 45, 1e-9);

@@ -25,10 +25,10 @@ TEST(Detector, PoolsTheWindowsThatHoldAPoint) {
                                                {cv::Rect(8, 0, 64, 32), 0.2, b},
                                                {cv::Rect(40, 0, 32, 32), 0.6, c}};
   const PointPooling p = PoolWindows(points, windows, 15);
-  EXPECT_DOUBLE_EQ(p.planarity[0], 0.8);         // the median of 0.9, 0.8, 0.2
-  EXPECT_DOUBLE_EQ(p.planarity[1], 0.6);         // of 0.8, 0.2, 0.6
-  EXPECT_DOUBLE_EQ(p.planarity[2], 0.5);         // no window: undecided
-  EXPECT_LT((p.normals[0] - a).norm(), 0.05);    // the light, far normal b hardly moves the robust mean
+  EXPECT_DOUBLE_EQ(p.planarity[0], 0.8);       // the median of 0.9, 0.8, 0.2
+  EXPECT_DOUBLE_EQ(p.planarity[1], 0.6);       // of 0.8, 0.2, 0.6
+  EXPECT_DOUBLE_EQ(p.planarity[2], 0.5);       // no window: undecided
+  EXPECT_LT((p.normals[0] - a).norm(), 0.05);  // the light, far normal b hardly moves the robust mean
   EXPECT_EQ(p.normals[2], Eigen::Vector3d::Zero());
 }
 

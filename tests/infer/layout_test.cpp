@@ -2,7 +2,6 @@
 // images of families of parallel 3D lines and on a known linear angle field.
 #include <gtest/gtest.h>
 
-
 #include <cmath>
 
 #include "pdvo/common/errors.h"
@@ -76,10 +75,10 @@ TEST(Layout, ObliqueFacadeEdgesTurnTowardsTheirVanishingPoint) {
   const Eigen::VectorXd f = LayoutFeature(r);
   const Eigen::Vector2d v = Project(a), c(r.box.x + r.box.width / 2, r.box.y + r.box.height / 2);
   const double h = 1e-3 * kWidth;  // a step of 1/1000 image width
-  const double along_x = (AngleTowards(c + Eigen::Vector2d(h, 0), v) - AngleTowards(c - Eigen::Vector2d(h, 0), v)) /
-                         2e-3;
-  const double along_y = (AngleTowards(c + Eigen::Vector2d(0, h), v) - AngleTowards(c - Eigen::Vector2d(0, h), v)) /
-                         2e-3;
+  const double along_x =
+      (AngleTowards(c + Eigen::Vector2d(h, 0), v) - AngleTowards(c - Eigen::Vector2d(h, 0), v)) / 2e-3;
+  const double along_y =
+      (AngleTowards(c + Eigen::Vector2d(0, h), v) - AngleTowards(c - Eigen::Vector2d(0, h), v)) / 2e-3;
   EXPECT_NEAR(f[4], AngleTowards(c, v), 0.02);
   EXPECT_NEAR(f[5], along_x, 0.15 * std::abs(along_y));  // ~0 here: the centre is level with the vanishing point
   EXPECT_NEAR(f[6], along_y, 0.15 * std::abs(along_y));

@@ -27,9 +27,9 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // and vertical lines, seen by a camera pitched and rolled by the given angles (the world's y axis is down).
 struct Scene {
   cv::Mat image;
-  Region region;               // the plane's image
-  Eigen::Vector3d normal;      // camera frame, towards the camera
-  Eigen::Vector3d up;          // camera frame: the world's y axis
+  Region region;           // the plane's image
+  Eigen::Vector3d normal;  // camera frame, towards the camera
+  Eigen::Vector3d up;      // camera frame: the world's y axis
 };
 
 // Which lines: a grid (crossing each other), or horizontal lines on one half of the plane and vertical ones
@@ -38,10 +38,9 @@ enum class Lines { kGrid, kApart, kHorizontal, kVertical };
 
 Scene DrawScene(double azimuth_deg, double pitch_deg, double roll_deg, Lines lines = Lines::kGrid) {
   const double az = azimuth_deg * kDegree;
-  const Eigen::Matrix3d cam_from_world =
-      (Eigen::AngleAxisd(roll_deg * kDegree, Eigen::Vector3d::UnitZ()) *
-       Eigen::AngleAxisd(pitch_deg * kDegree, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d cam_from_world = (Eigen::AngleAxisd(roll_deg * kDegree, Eigen::Vector3d::UnitZ()) *
+                                          Eigen::AngleAxisd(pitch_deg * kDegree, Eigen::Vector3d::UnitX()))
+                                             .toRotationMatrix();
   const Eigen::Vector3d origin(0, 0, 6), along(std::cos(az), 0, std::sin(az)), down(0, 1, 0);
   auto project = [&](const Eigen::Vector3d& world) {
     const Eigen::Vector3d c = cam_from_world * world;

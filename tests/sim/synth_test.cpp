@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <Eigen/Eigenvalues>
+#include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -77,7 +77,8 @@ TEST(Synth, DepthReprojectsExactlyBetweenFrames) {
     renderer.RenderGeometry(s.walk[i].world_from_cam, &a);
     renderer.RenderGeometry(s.walk[i + k].world_from_cam, &b);
     int compared = 0;
-    const double worst = ReprojectionError(s.camera, a, s.walk[i].world_from_cam, b, s.walk[i + k].world_from_cam, &compared);
+    const double worst =
+        ReprojectionError(s.camera, a, s.walk[i].world_from_cam, b, s.walk[i + k].world_from_cam, &compared);
     EXPECT_GT(compared, 3000) << i << "->" << i + k;
     EXPECT_LT(worst, 1e-3) << i << "->" << i + k;
   }
@@ -102,7 +103,8 @@ TEST(Synth, AnnotationNormalsAgreeWithNormalsFromDepth) {
       for (int p = 0; p < static_cast<int>(mask.total()); ++p) {
         if (mask.at<uchar>(p)) ++votes[f.id.at<int>(p)];
       }
-      const int id = std::max_element(votes.begin(), votes.end(), [](auto& x, auto& y) { return x.second < y.second; })->first;
+      const int id =
+          std::max_element(votes.begin(), votes.end(), [](auto& x, auto& y) { return x.second < y.second; })->first;
       ASSERT_GE(id, 0);
       if (votes[id] < 200) continue;
       // Least-squares plane through the back-projected depth of those pixels.
@@ -201,7 +203,8 @@ TEST(Synth, DepthFilesReprojectWithinAMillimetre) {
     out->id.setTo(-1, out->depth == 0);  // beyond the 16-bit range: unknown
   }
   int compared = 0;
-  const double worst = ReprojectionError(camera, a, *frames[0].world_from_cam, b, *frames[11].world_from_cam, &compared);
+  const double worst =
+      ReprojectionError(camera, a, *frames[0].world_from_cam, b, *frames[11].world_from_cam, &compared);
   EXPECT_GT(compared, 3000);
   EXPECT_LT(worst, 1e-3);
 }
@@ -263,8 +266,8 @@ TEST(Synth, AnnotateDepthRecoversTheStreetsPlanes) {
     renderer.RenderGeometry(s.walk[i].world_from_cam, &f);
     cv::Mat depth = f.depth.clone();
     depth.setTo(0, depth > 65535 / kSynthDepthScale);  // as stored
-    const PlaneComparison c =
-        ComparePlanes(AnnotateFrame(s.street, f, s.walk[i].world_from_cam, s.camera, "x.png"), finder.Annotate(depth, "x.png"));
+    const PlaneComparison c = ComparePlanes(AnnotateFrame(s.street, f, s.walk[i].world_from_cam, s.camera, "x.png"),
+                                            finder.Annotate(depth, "x.png"));
     for (const PlaneMatch& m : c.matches) {
       ious.push_back(m.iou);
       worst_angle = std::max(worst_angle, m.normal_angle_deg);
@@ -277,9 +280,10 @@ TEST(Synth, AnnotateDepthRecoversTheStreetsPlanes) {
   EXPECT_GT(ious[ious.size() / 2], 0.9);  // median IoU of matched planes
   EXPECT_GT(ious[ious.size() / 4], 0.8);  // three quarters of them above 0.8
   EXPECT_LT(worst_angle, 2.0);
-  std::printf("annotate-depth on a synthetic street: %d of %d planes matched, IoU median %.3f, lower quartile %.3f, "
-              "worst normal %.4f deg\n", summary.matched, summary.reference_planes, ious[ious.size() / 2],
-              ious[ious.size() / 4], worst_angle);
+  std::printf(
+      "annotate-depth on a synthetic street: %d of %d planes matched, IoU median %.3f, lower quartile %.3f, "
+      "worst normal %.4f deg\n",
+      summary.matched, summary.reference_planes, ious[ious.size() / 2], ious[ious.size() / 4], worst_angle);
 }
 
 TEST(Synth, ShippedDefaultConfigEqualsTheDefaults) {

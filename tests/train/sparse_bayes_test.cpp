@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <dlib/svm.h>
+#include <cmath>
 #include <random>
 
 #include "pdvo/common/errors.h"

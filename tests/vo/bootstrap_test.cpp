@@ -46,8 +46,8 @@ TEST(Bootstrap, FindsAKnownMotion) {
   ASSERT_TRUE(EstimateTwoView(kCamera, v.first, v.second, 1.5, kInverseDepth, &motion));
   EXPECT_GT(motion.inliers.size(), 140u);
   EXPECT_LT(LogSO3(truth.rotation.conjugate() * motion.first_from_second.rotation).norm() * 180 / M_PI, 0.05);
-  const double angle = std::acos(std::clamp(
-      truth.translation.normalized().dot(motion.first_from_second.translation.normalized()), -1.0, 1.0));
+  const double angle = std::acos(
+      std::clamp(truth.translation.normalized().dot(motion.first_from_second.translation.normalized()), -1.0, 1.0));
   EXPECT_LT(angle * 180 / M_PI, 0.1);
   // The points are the true ones at one scale, the one that puts their median distance at 1 / inverse depth.
   const double scale = motion.first_from_second.translation.norm() / truth.translation.norm();

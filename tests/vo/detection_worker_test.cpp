@@ -105,14 +105,13 @@ TEST(DetectionWorker, ADetectorThatThrowsGivesItsMessage) {
 
 TEST(DetectionWorker, ASlowDetectorIsGivenUp) {
   // Keyframe 0 takes 300 ms, longer than the 50 ms timeout; keyframe 1 is quick.
-  DetectionWorker worker(
-      [](const KeyframeImage& k) { return Slow(milliseconds(k.frame == 0 ? 300 : 0))(k); },
-      DetectionSchedule::kDeterministic, 1, 0.05);
+  DetectionWorker worker([](const KeyframeImage& k) { return Slow(milliseconds(k.frame == 0 ? 300 : 0))(k); },
+                         DetectionSchedule::kDeterministic, 1, 0.05);
   worker.Offer(Keyframe(0));
   worker.Offer(Keyframe(1));               // waits
   EXPECT_TRUE(worker.Collect(1).empty());  // 0 is given up; 1 starts, behind it in the thread
   EXPECT_EQ(worker.timed_out(), 1);
-  std::this_thread::sleep_for(milliseconds(600));  // both end
+  std::this_thread::sleep_for(milliseconds(600));            // both end
   const std::vector<DetectionResult> r = worker.Collect(2);  // 0's late result is dropped
   ASSERT_EQ(r.size(), 1u);
   EXPECT_EQ(r[0].keyframe, 1);

@@ -146,8 +146,8 @@ TEST(Filter, PointJoiningAPlaneIsFusedIntoIt) {
     Filter a = f, b = f;
     a.Apply(1e-7 * Eigen::VectorXd::Unit(n, i));
     b.Apply(-1e-7 * Eigen::VectorXd::Unit(n, i));
-    h[i] = (a.points().at(point).inverse_depth - along_ray(a) - b.points().at(point).inverse_depth + along_ray(b)) /
-           2e-7;
+    h[i] =
+        (a.points().at(point).inverse_depth - along_ray(a) - b.points().at(point).inverse_depth + along_ray(b)) / 2e-7;
   }
   const Eigen::MatrixXd p = f.covariance();
   const double s = (h * p * h.transpose())(0, 0) + sigma * sigma;
@@ -167,7 +167,7 @@ TEST(Filter, PointJoiningAPlaneIsFusedIntoIt) {
   EXPECT_FALSE(f.points().count(point));
   ASSERT_EQ(f.size(), n - 1);
   const double gain = plane_variance / (plane_variance + point_variance + sigma * sigma);
-  EXPECT_GT(gain, 0.1);  // the test says something
+  EXPECT_GT(gain, 0.1);                                                          // the test says something
   EXPECT_NEAR(along_ray(f), on_plane + gain * 0.1 * on_plane, 1e-3 * on_plane);  // first order: to 0.1%
   Eigen::RowVectorXd h_after(n - 1);
   for (int i = 0, k = 0; i < n; ++i) {
@@ -384,14 +384,14 @@ TEST(Filter, CovarianceStaysSymmetricPositiveSemidefinite) {
     std::vector<PointMeasurement> z;
     for (const auto& [id, p] : f.points()) {
       Eigen::Vector2d pixel;
-      if (f.PredictPoint(kCamera, id, &pixel, nullptr)) z.push_back({id, pixel + Eigen::Vector2d(noise(rng), noise(rng)), 1});
+      if (f.PredictPoint(kCamera, id, &pixel, nullptr))
+        z.push_back({id, pixel + Eigen::Vector2d(noise(rng), noise(rng)), 1});
     }
     ASSERT_TRUE(f.Update(kCamera, z).ok());
     EXPECT_LT((f.covariance() - f.covariance().transpose()).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
   }
 }
-
 
 // Step and PredictAfter (1-point RANSAC's hypotheses) give exactly what an update of a copy would: the same step,
 // bit for bit, and the same predictions after it; the filter itself is unchanged.

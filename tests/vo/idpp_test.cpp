@@ -72,8 +72,8 @@ TEST(Idpp, BehindTheCameraIsNotProjected) {
   Scene s;
   s.world_from_current = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 5));  // past the point
   Eigen::Vector2d pixel(-1, -1);
-  EXPECT_FALSE(ProjectInverseDepth(kCamera, s.world_from_current, s.world_from_ref, Eigen::Vector3d(0, 0, 1), 0.5,
-                                   &pixel));
+  EXPECT_FALSE(
+      ProjectInverseDepth(kCamera, s.world_from_current, s.world_from_ref, Eigen::Vector3d(0, 0, 1), 0.5, &pixel));
   EXPECT_EQ(pixel, Eigen::Vector2d(-1, -1));
 }
 

@@ -19,7 +19,8 @@ TEST(Map, WritesPointsPlanesAndPathAsPly) {
   plane.normal = Eigen::Vector3d(0, 0, -1);
   map.planes = {plane};
   Trajectory path;
-  for (int k = 0; k < 3; ++k) path.push_back({k * 0.1, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(k, 0, 0))});
+  for (int k = 0; k < 3; ++k)
+    path.push_back({k * 0.1, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(k, 0, 0))});
   const test::TempDir dir;
   WritePly(dir / "map.ply", map, path);
   std::istringstream in(ReadFile(dir / "map.ply"));

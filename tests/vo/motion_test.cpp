@@ -43,8 +43,8 @@ TEST(Motion, JacobiansMatchCentralDifferences) {
     Matrix12d numeric;
     for (int i = 0; i < 12; ++i) {
       const Vector12d e = eps * Vector12d::Unit(i);
-      numeric.col(i) = (PredictCamera(s.Plus(e), dt).Minus(predicted) -
-                        PredictCamera(s.Plus(-e), dt).Minus(predicted)) / (2 * eps);
+      numeric.col(i) =
+          (PredictCamera(s.Plus(e), dt).Minus(predicted) - PredictCamera(s.Plus(-e), dt).Minus(predicted)) / (2 * eps);
     }
     EXPECT_LT((f - numeric).cwiseAbs().maxCoeff(), 1e-7) << "analytic\n" << f << "\nnumeric\n" << numeric;
     // Impulses (V, W) act as changes of the velocities before the step.

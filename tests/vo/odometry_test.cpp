@@ -57,9 +57,9 @@ TEST(Odometry, BootstrapFindsTheMotion) {
       at = static_cast<int>(k);
       const Rigid3d truth = s.walk[0].world_from_cam.Inverse() * s.walk[k].world_from_cam;
       const Rigid3d estimate = odometry.world_from_cam();  // the first camera is the world
-      const double angle = std::acos(
-          std::clamp(truth.translation.normalized().dot(estimate.translation.normalized()), -1.0, 1.0));
-      EXPECT_LT(angle * 180 / M_PI, 3.0);  // measured 0.41 deg
+      const double angle =
+          std::acos(std::clamp(truth.translation.normalized().dot(estimate.translation.normalized()), -1.0, 1.0));
+      EXPECT_LT(angle * 180 / M_PI, 3.0);                                                          // measured 0.41 deg
       EXPECT_LT(LogSO3(truth.rotation.conjugate() * estimate.rotation).norm() * 180 / M_PI, 0.5);  // measured 0.18 deg
     }
   }
@@ -98,7 +98,8 @@ TEST(Odometry, UsedMatchesAgreeWithTheTruth) {
       double lo = 1e9, hi = 0;
       for (int dy = -3; dy <= 3; ++dy) {
         for (int dx = -3; dx <= 3; ++dx) {
-          const float z = depth.at<float>(std::clamp(at.y + dy, 0, depth.rows - 1), std::clamp(at.x + dx, 0, depth.cols - 1));
+          const float z =
+              depth.at<float>(std::clamp(at.y + dy, 0, depth.rows - 1), std::clamp(at.x + dx, 0, depth.cols - 1));
           lo = std::min<double>(lo, z);
           hi = std::max<double>(hi, z);
         }
@@ -251,7 +252,7 @@ TEST(Odometry, RefusesBadFrames) {
   EXPECT_THROW(odometry.Track(cv::Mat(240, 320, CV_8UC3), 0), InvalidArgument);  // colour
   EXPECT_THROW(odometry.Track(cv::Mat(), 0), InvalidArgument);
   odometry.Track(s.grey[0], 1.0);
-  EXPECT_THROW(odometry.Track(s.grey[1], 1.0), InvalidArgument);                   // time did not advance
+  EXPECT_THROW(odometry.Track(s.grey[1], 1.0), InvalidArgument);  // time did not advance
   EXPECT_THROW(odometry.Track(s.grey[1](cv::Rect(0, 0, 100, 100)).clone(), 2.0), InvalidArgument);  // size
   VoOptions bad;
   bad.features.border = bad.search.patch_half;  // patches would leave the image

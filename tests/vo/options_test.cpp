@@ -34,7 +34,8 @@ std::set<std::string> Keys(const cv::FileNode& node, const std::string& prefix =
 TEST(VoOptions, TheShippedFileHoldsEveryDefault) {
   EXPECT_EQ(LoadOptions<VoOptions>(kDefaults, "vo"), VoOptions{});
   cv::FileStorage written(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-  written << "vo" << "{";
+  written << "vo"
+          << "{";
   WriteOptions(written, VoOptions{});
   written << "}";
   cv::FileStorage defaults(written.releaseAndGetString(), cv::FileStorage::READ | cv::FileStorage::MEMORY);

@@ -70,10 +70,9 @@ TEST(Patch, NccIsInvariantToGainAndOffset) {
   EXPECT_NEAR(Ncc(a, brighter), 1, 1e-6);
   EXPECT_NEAR(Ncc(a, negative), -1, 1e-6);
   EXPECT_LT(std::abs(Ncc(a, image(cv::Rect(200, 150, 9, 9)))), 0.9);  // elsewhere in the texture
-  EXPECT_EQ(Ncc(a, cv::Mat(9, 9, CV_8U, cv::Scalar(5))), 0);            // flat
+  EXPECT_EQ(Ncc(a, cv::Mat(9, 9, CV_8U, cv::Scalar(5))), 0);          // flat
   EXPECT_THROW(Ncc(a, image(cv::Rect(0, 0, 5, 5))), InvalidArgument);
 }
-
 
 // SearchPatch against known shifts: an integer shift is found exactly, sub-pixel shifts closer than the nearest
 // whole pixel would be (on average over fractions of 0.1 to 0.9 px); a match far outside the search ellipse is not
@@ -108,8 +107,8 @@ TEST(SearchPatch, FindsKnownShifts) {
   RecordProperty("mean_subpixel_error_px", std::to_string(subpixel / n));
   RecordProperty("mean_whole_pixel_error_px", std::to_string(whole / n));
   // Predicted 8 px from the match with a 0.5 px sigma: the ellipse (1.5 px) does not reach it.
-  EXPECT_FALSE(SearchPatch(image, patch, centre + Eigen::Vector2d(8, 0), 0.25 * Eigen::Matrix2d::Identity(), options,
-                           &found));
+  EXPECT_FALSE(
+      SearchPatch(image, patch, centre + Eigen::Vector2d(8, 0), 0.25 * Eigen::Matrix2d::Identity(), options, &found));
   cv::Mat other(image.size(), CV_8U);
   cv::RNG rng(99);
   rng.fill(other, cv::RNG::UNIFORM, 0, 256);

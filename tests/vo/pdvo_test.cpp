@@ -41,7 +41,8 @@ struct PdvoRun {
 PdvoRun RunPdvo(const Street& s, const VoOptions& options, PlaneDetector detector) {
   Odometry odometry(s.camera, options, nullptr, std::move(detector));
   PdvoRun r;
-  for (size_t k = 0; k < s.grey.size(); ++k) r.frames.push_back(odometry.Track(s.grey[k], s.walk[k].timestamp, s.colour[k]));
+  for (size_t k = 0; k < s.grey.size(); ++k)
+    r.frames.push_back(odometry.Track(s.grey[k], s.walk[k].timestamp, s.colour[k]));
   r.trajectory = odometry.trajectory();
   r.mapping = odometry.mapping();
   r.counts = odometry.detection_counts();
@@ -166,8 +167,9 @@ TEST(Pdvo, TheRealTimeScheduleRunsToTheEnd) {
 
 TEST(Pdvo, ADetectorThatThrowsStopsNothing) {
   const Street& s = TestStreet();
-  const PdvoRun r = RunPdvo(s, PdvoOptionsFor(DetectionSchedule::kDeterministic),
-                        [](const KeyframeImage&) -> std::vector<DetectedPlane> { throw std::runtime_error("no model"); });
+  const PdvoRun r =
+      RunPdvo(s, PdvoOptionsFor(DetectionSchedule::kDeterministic),
+              [](const KeyframeImage&) -> std::vector<DetectedPlane> { throw std::runtime_error("no model"); });
   EXPECT_EQ(r.trajectory.size(), s.grey.size());
   EXPECT_GE(r.counts.failed, 1);
   for (const FrameStats& f : r.frames) {

@@ -97,7 +97,7 @@ TEST(PlaneSeeder, SeedsWhereCornersAreDensest) {
   PlaneOptions options;
   DensestCornersSeeder seeder(options);
   const std::vector<PlaneSeed> seeds = seeder.Seed(keyframe, kCamera);
-  ASSERT_EQ(seeds.size(), 2u);  // the lone corner has too few neighbours
+  ASSERT_EQ(seeds.size(), 2u);    // the lone corner has too few neighbours
   EXPECT_LT(seeds[0].corner, 9);  // in the dense cluster (every corner of it has the other 8 within reach)
   EXPECT_GE(seeds[1].corner, 9);  // then the sparser one, more than twice grow_radius away
   EXPECT_LT(seeds[1].corner, 15);

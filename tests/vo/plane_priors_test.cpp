@@ -74,8 +74,8 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   EXPECT_EQ(plane.reference, s.reference);
   EXPECT_LT((plane.plane.normal - tilted).norm(), 1e-12);
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(s.filter.covariance()(plane.offset + k, plane.offset + k), s.options.normal_sigma * s.options.normal_sigma,
-                1e-12);
+    EXPECT_NEAR(s.filter.covariance()(plane.offset + k, plane.offset + k),
+                s.options.normal_sigma * s.options.normal_sigma, 1e-12);
   }
   // Seeded at the unused corner inside the polygon nearest its centroid (160, 120).
   const PlaneTrack& track = s.tracks.planes.at(id);
@@ -96,7 +96,8 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   // rho_p = -rho / (n . m).
   std::vector<double> says;
   for (const auto& [point, p] : s.filter.points()) {
-    if (InsidePolygon(outline, s.tracks.points.at(point).keyframe_pixel)) says.push_back(-p.inverse_depth / tilted.dot(p.ray));
+    if (InsidePolygon(outline, s.tracks.points.at(point).keyframe_pixel))
+      says.push_back(-p.inverse_depth / tilted.dot(p.ray));
   }
   std::sort(says.begin(), says.end());
   ASSERT_GE(says.size(), 3u);
@@ -158,11 +159,11 @@ TEST(PlanePriors, RefusedDetectionsAreCounted) {
   DetectedPlane line = Box(60, 40, 260, 200, kFacing);
   line.polygon.resize(2);
   const Eigen::Vector3d edge_on = Eigen::Vector3d(1, 0, -0.05).normalized();  // along the rays
-  const SeedingOutcome o =
-      s.Seed({invalid, line, Box(10, 10, 40, 40, kFacing), Box(60, 40, 260, 200, edge_on), Box(60, 40, 260, 200, -kFacing)});
+  const SeedingOutcome o = s.Seed(
+      {invalid, line, Box(10, 10, 40, 40, kFacing), Box(60, 40, 260, 200, edge_on), Box(60, 40, 260, 200, -kFacing)});
   EXPECT_EQ(o.detected, 5);
   EXPECT_EQ(o.invalid, 2);
-  EXPECT_EQ(o.small, 1);   // 900 px^2 < min_area
+  EXPECT_EQ(o.small, 1);    // 900 px^2 < min_area
   EXPECT_EQ(o.grazing, 2);  // edge-on, and facing away
   EXPECT_EQ(o.seeded, 0);
   EXPECT_TRUE(s.filter.planes().empty());

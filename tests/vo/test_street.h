@@ -7,9 +7,9 @@
 
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/eval/plane_match.h"
-#include "pdvo/vo/odometry.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
+#include "pdvo/vo/odometry.h"
 
 namespace pdvo::vo {
 
@@ -18,7 +18,7 @@ struct Street {
   sim::Street street;
   Trajectory walk;
   std::vector<cv::Mat> grey;
-  std::vector<cv::Mat> depth;  // CV_32F, z in metres, 0 for the sky
+  std::vector<cv::Mat> depth;    // CV_32F, z in metres, 0 for the sky
   std::vector<cv::Mat> surface;  // CV_16S: the true surface (coplanar polygons share one), -1 for anything else
   Camera camera;
   std::vector<cv::Mat> colour;
@@ -42,8 +42,8 @@ inline const Street& TestStreet() {
       s.grey.push_back(grey);
       s.depth.push_back(frame.depth);
       s.colour.push_back(frame.image);
-      s.planes.push_back(DetectedPlanes(sim::AnnotateFrame(s.street, frame, pose.world_from_cam, s.camera, ""),
-                                        s.camera.width));
+      s.planes.push_back(
+          DetectedPlanes(sim::AnnotateFrame(s.street, frame, pose.world_from_cam, s.camera, ""), s.camera.width));
       cv::Mat surface(frame.id.size(), CV_16S);
       for (int y = 0; y < surface.rows; ++y) {
         for (int x = 0; x < surface.cols; ++x) {

@@ -52,7 +52,7 @@ TEST(Tracks, HistoriesSayWhenAFeatureLeaves) {
   EXPECT_TRUE(Tracks::Gone({o.max_misses + 1, 10, 0}, o));
   EXPECT_FALSE(Tracks::Gone({0, 10, 4}, o));  // 4 of 10 rejected: not more than 0.4
   EXPECT_TRUE(Tracks::Gone({0, 10, 5}, o));
-  EXPECT_FALSE(Tracks::Gone({0, 2, 2}, o));   // fewer than min_rejections
+  EXPECT_FALSE(Tracks::Gone({0, 2, 2}, o));  // fewer than min_rejections
 }
 
 TEST(FramePreparer, MakesWorkingFramesForTheWorkingCamera) {

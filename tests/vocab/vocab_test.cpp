@@ -70,7 +70,8 @@ TEST(Features, ColourDescriptorIsTheLabMeanOfEachCell) {
   ASSERT_GT(f.size(), 0u);
   cv::Mat lab;
   cv::cvtColor(cv::Mat(1, 1, CV_8UC3, red), lab, cv::COLOR_BGR2Lab);
-  for (int k = 0; k < kColourDims; ++k) EXPECT_NEAR(f.colour.at<float>(0, k), lab.at<cv::Vec3b>(0)[k % 3] / 255.0f, 1e-6);
+  for (int k = 0; k < kColourDims; ++k)
+    EXPECT_NEAR(f.colour.at<float>(0, k), lab.at<cv::Vec3b>(0)[k % 3] / 255.0f, 1e-6);
 }
 
 // The gradient descriptor turns with the image: rotating the image by 90 degrees (clockwise on screen, +90 in
@@ -100,7 +101,7 @@ TEST(Features, GradientDescriptorRotatesWithTheImage) {
       }
     }
   }
-  EXPECT_GT(total, 100);  // a textured patch, not an empty descriptor
+  EXPECT_GT(total, 100);   // a textured patch, not an empty descriptor
   EXPECT_LT(worst, 0.05);  // float rounding of the angles at bin borders only
 }
 

@@ -19,8 +19,7 @@ OnmfResult FactoriseOrthogonal(const Eigen::MatrixXd& x, const OnmfOptions& opti
   PDVO_THROW_CHECK(x.size() > 0 && x.allFinite() && x.minCoeff() >= 0, InvalidArgument,
                    "ONMF: the data must be non-empty, finite and non-negative");
   PDVO_THROW_CHECK(options.topics <= x.rows() && options.topics <= x.cols(), InvalidArgument,
-                   "ONMF: " << options.topics << " topics for " << x.rows() << " words and " << x.cols()
-                            << " regions");
+                   "ONMF: " << options.topics << " topics for " << x.rows() << " words and " << x.cols() << " regions");
   constexpr double kEpsilon = 1e-12;
   const int k = options.topics;
   std::mt19937_64 rng(options.seed);

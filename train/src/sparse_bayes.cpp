@@ -18,11 +18,11 @@ RvmFunction TrainSparseBayesRegression(const Eigen::MatrixXd& x, const Eigen::Ve
   const Eigen::Index m_all = n + 1;
   Eigen::MatrixXd phi(n, m_all);
   const Eigen::VectorXd norms = x.rowwise().squaredNorm();
-  phi.leftCols(n) = (-o.gamma * ((norms.replicate(1, n) + norms.transpose().replicate(n, 1)) - 2 * x * x.transpose())
-                                    .cwiseMax(0.0))
-                        .array()
-                        .exp()
-                        .matrix();
+  phi.leftCols(n) =
+      (-o.gamma * ((norms.replicate(1, n) + norms.transpose().replicate(n, 1)) - 2 * x * x.transpose()).cwiseMax(0.0))
+          .array()
+          .exp()
+          .matrix();
   phi.col(n).setOnes();
   const Eigen::MatrixXd gram = phi.transpose() * phi;
   const Eigen::VectorXd phi_t = phi.transpose() * t;

@@ -87,8 +87,8 @@ std::array<RvmFunction, 3> TrainNormal(const Eigen::MatrixXd& x, const std::vect
 }
 
 // Splits row indices into (train, test) for fold `k`.
-void Split(const std::vector<int>& image_of_row, const std::vector<int>& fold_of_image, int k,
-           std::vector<int>* train, std::vector<int>* test) {
+void Split(const std::vector<int>& image_of_row, const std::vector<int>& fold_of_image, int k, std::vector<int>* train,
+           std::vector<int>* test) {
   train->clear();
   test->clear();
   for (size_t r = 0; r < image_of_row.size(); ++r) {
@@ -183,12 +183,10 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   stage = Clock::now();
   PDVO_THROW_CHECK(static_cast<int>(descriptor_count) >= std::max(o.gradient_words, o.colour_words), InvalidArgument,
                    "train: " << descriptor_count << " salient points in all images, fewer than the vocabulary size");
-  const Vocabulary gradient_words =
-      Vocabulary::Build(DrawDescriptors(features, true, o.vocabulary_samples, rng), o.gradient_words, seed,
-                        o.kmeans_iterations);
-  const Vocabulary colour_words =
-      Vocabulary::Build(DrawDescriptors(features, false, o.vocabulary_samples, rng), o.colour_words, seed + 1,
-                        o.kmeans_iterations);
+  const Vocabulary gradient_words = Vocabulary::Build(DrawDescriptors(features, true, o.vocabulary_samples, rng),
+                                                      o.gradient_words, seed, o.kmeans_iterations);
+  const Vocabulary colour_words = Vocabulary::Build(DrawDescriptors(features, false, o.vocabulary_samples, rng),
+                                                    o.colour_words, seed + 1, o.kmeans_iterations);
   std::vector<ImageWords> words;
   for (const Features& f : features) words.push_back(QuantiseFeatures(f, gradient_words, colour_words));
   features.clear();
@@ -234,8 +232,8 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (const std::vector<int>& draw : draws) used.insert(used.end(), draw.begin(), draw.end());
   std::sort(used.begin(), used.end());
   used.erase(std::unique(used.begin(), used.end()), used.end());
-  PDVO_LOG(Info) << "training regions: " << o.classifiers << " draws of " << per_class << " planes and "
-                 << per_class << " non-planes, " << normals.size() << " with normals, " << used.size() << " in all";
+  PDVO_LOG(Info) << "training regions: " << o.classifiers << " draws of " << per_class << " planes and " << per_class
+                 << " non-planes, " << normals.size() << " with normals, " << used.size() << " in all";
 
   // 4. Topics by orthogonal NMF of the training regions' word histograms.
   stage = Clock::now();
@@ -244,9 +242,9 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   for (size_t k = 0; k < basis.size(); ++k) histograms.col(k) = regions[basis[k]].words.histogram;
   OnmfOptions topic_options = o.topics;
   topic_options.seed = seed;
-  PDVO_THROW_CHECK(static_cast<int>(basis.size()) >= topic_options.topics, InvalidArgument,
-                   "train: " << basis.size() << " training regions, fewer than the " << topic_options.topics
-                             << " topics");
+  PDVO_THROW_CHECK(
+      static_cast<int>(basis.size()) >= topic_options.topics, InvalidArgument,
+      "train: " << basis.size() << " training regions, fewer than the " << topic_options.topics << " topics");
   const OnmfResult topics = FactoriseOrthogonal(histograms, topic_options);
   PDVO_LOG(Info) << "[time] " << topic_options.topics << " topics (relative error "
                  << (topics.errors.empty() ? 0.0 : topics.errors.back()) << ") in " << Since(stage) << " s";
@@ -288,18 +286,18 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   const WidthChoice classifier_width =
       ChooseWidth(rvm.gammas, folds, image_c, fold_of_image, "classifier error",
                   [&](const auto& train, const auto& test, double g) {
-        const std::vector<double> train_labels = Pick(labels, train);
-        std::optional<double> errors;
-        if (std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
-            std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
-          return errors;  // a fold without both classes says nothing
-        }
-        const RvmFunction fn =
-            internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g), rvm.epsilon, rvm.max_iterations);
-        errors = 0.0;
-        for (int r : test) *errors += (fn(xc.row(r).transpose()) >= 0) != (labels[r] > 0);
-        return errors;
-      });
+                    const std::vector<double> train_labels = Pick(labels, train);
+                    std::optional<double> errors;
+                    if (std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
+                        std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
+                      return errors;  // a fold without both classes says nothing
+                    }
+                    const RvmFunction fn = internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g),
+                                                                        rvm.epsilon, rvm.max_iterations);
+                    errors = 0.0;
+                    for (int r : test) *errors += (fn(xc.row(r).transpose()) >= 0) != (labels[r] > 0);
+                    return errors;
+                  });
   const double best_gamma = classifier_width.gamma;
   PlaneModel model;
   std::ostringstream sizes;
@@ -323,11 +321,11 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   const WidthChoice normal_width =
       ChooseWidth(rvm.gammas, folds, image_n, fold_of_image, "normal error (deg)",
                   [&](const auto& train, const auto& test, double g) {
-        const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
-        std::optional<double> sum = 0.0;
-        for (int r : test) *sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose()));
-        return sum;
-      });
+                    const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
+                    std::optional<double> sum = 0.0;
+                    for (int r : test) *sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose()));
+                    return sum;
+                  });
   const double best_normal_gamma = normal_width.gamma;
   if (!normals.empty()) {
     model.normal = TrainNormal(xn, targets, gamma_of(best_normal_gamma), rvm);
@@ -335,9 +333,9 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
     PDVO_LOG(Warning) << "no plane regions with normals: the model predicts no orientation";
     for (RvmFunction& f : model.normal) f.gamma = gamma_of(best_normal_gamma);
   }
-  PDVO_LOG(Info) << "[time] normal regressors (gamma " << best_normal_gamma << "/D, " << model.normal[0].size()
-                 << "+" << model.normal[1].size() << "+" << model.normal[2].size() << " relevance vectors) in "
-                 << Since(stage) << " s";
+  PDVO_LOG(Info) << "[time] normal regressors (gamma " << best_normal_gamma << "/D, " << model.normal[0].size() << "+"
+                 << model.normal[1].size() << "+" << model.normal[2].size() << " relevance vectors) in " << Since(stage)
+                 << " s";
 
   model.options = o.recogniser;
   model.gradient_words = gradient_words;

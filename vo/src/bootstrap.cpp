@@ -55,8 +55,8 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from,
   motion->points.clear();
   for (int i = 0; i < inliers.rows; ++i) {
     if (!inliers.at<uchar>(i)) continue;
-    const Eigen::Vector4d h(triangulated.at<double>(0, i), triangulated.at<double>(1, i),
-                            triangulated.at<double>(2, i), triangulated.at<double>(3, i));
+    const Eigen::Vector4d h(triangulated.at<double>(0, i), triangulated.at<double>(1, i), triangulated.at<double>(2, i),
+                            triangulated.at<double>(3, i));
     if (std::abs(h(3)) < 1e-12) continue;
     const Eigen::Vector3d x = h.hnormalized();
     const Eigen::Vector3d in_second = rotation * x + translation;

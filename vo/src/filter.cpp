@@ -27,9 +27,8 @@ void Filter::Predict(double dt, const MotionNoise& noise) {
   Eigen::Matrix<double, 12, 6> g;
   camera_ = PredictCamera(camera_, dt, &f, &g);
   const int n = size();
-  covariance_.topLeftCorner<12, 12>() =
-      f * covariance_.topLeftCorner<12, 12>() * f.transpose() +
-      ProcessNoise(g, dt, noise.linear_acceleration, noise.angular_acceleration);
+  covariance_.topLeftCorner<12, 12>() = f * covariance_.topLeftCorner<12, 12>() * f.transpose() +
+                                        ProcessNoise(g, dt, noise.linear_acceleration, noise.angular_acceleration);
   if (n > 12) {
     covariance_.topRightCorner(12, n - 12) = f * covariance_.topRightCorner(12, n - 12);
     covariance_.bottomLeftCorner(n - 12, 12) = covariance_.topRightCorner(12, n - 12).transpose();

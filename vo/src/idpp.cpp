@@ -45,14 +45,14 @@ bool ProjectPlanePoint(const Camera& camera, const Rigid3d& world_from_current, 
   return true;
 }
 
-Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current,
-                                const Rigid3d& world_from_ref, const InversePlane& plane) {
+Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+                                const InversePlane& plane) {
   const Rigid3d current_from_ref = world_from_current.Inverse() * world_from_ref;
   Eigen::Matrix3d k;
   cv::cv2eigen(camera.K(), k);
-  const Eigen::Matrix3d euclidean = current_from_ref.rotation.toRotationMatrix() -
-                                    plane.inverse_distance * current_from_ref.translation *
-                                        plane.normal.normalized().transpose();
+  const Eigen::Matrix3d euclidean =
+      current_from_ref.rotation.toRotationMatrix() -
+      plane.inverse_distance * current_from_ref.translation * plane.normal.normalized().transpose();
   return k * euclidean * k.inverse();
 }
 

@@ -37,9 +37,9 @@ CameraState PredictCamera(const CameraState& s, double dt, Matrix12d* f, Eigen::
   const Eigen::Matrix3d eye = Eigen::Matrix3d::Identity();
   if (f) {
     f->setIdentity();
-    f->block<3, 3>(0, 6) = dt * eye;                       // position from velocity
-    f->block<3, 3>(3, 3) = step_rotation.transpose();      // an orientation error seen from the new orientation
-    f->block<3, 3>(3, 9) = dt * jr;                        // orientation from angular velocity
+    f->block<3, 3>(0, 6) = dt * eye;                   // position from velocity
+    f->block<3, 3>(3, 3) = step_rotation.transpose();  // an orientation error seen from the new orientation
+    f->block<3, 3>(3, 9) = dt * jr;                    // orientation from angular velocity
   }
   if (g) {
     g->setZero();

@@ -24,8 +24,7 @@ constexpr double kMinWarpInverseDepth = 1e-3;
 }  // namespace
 
 bool PriorOptions::Check() const {
-  PDVO_CHECK_OPTION(inverse_depth > 0 && inverse_depth_sigma > 0 && velocity_sigma > 0 &&
-                    angular_velocity_sigma > 0);
+  PDVO_CHECK_OPTION(inverse_depth > 0 && inverse_depth_sigma > 0 && velocity_sigma > 0 && angular_velocity_sigma > 0);
   return true;
 }
 
@@ -64,9 +63,9 @@ struct Odometry::Impl {
   std::unique_ptr<Filter> filter;
   Tracks tracks;
   MapRecord record;
-  Trajectory trajectory;                  // every frame's pose
-  std::vector<Observation> observations;  // of the last frame
-  std::mt19937 rng{1};                    // RANSAC; fixed seed: the same frames give the same trajectory
+  Trajectory trajectory;                        // every frame's pose
+  std::vector<Observation> observations;        // of the last frame
+  std::mt19937 rng{1};                          // RANSAC; fixed seed: the same frames give the same trajectory
   std::unique_ptr<DetectionWorker> detections;  // mode pdvo
   int detections_failed = 0;
   double last_time = 0;
@@ -134,11 +133,12 @@ struct Odometry::Impl {
       event.keyframe_gone = keyframe == tracks.keyframes.end();
       if (event.keyframe_gone) continue;
       event.seeding = SeedDetectedPlanes(event.result.planes, keyframe->first, frame, camera, o.pdvo, o.features,
-                                         o.prior.inverse_depth_sigma / o.prior.inverse_depth,
-                                         o.prior.inverse_depth, filter.get(), &tracks);
+                                         o.prior.inverse_depth_sigma / o.prior.inverse_depth, o.prior.inverse_depth,
+                                         filter.get(), &tracks);
     }
     if (stats->keyframe) {
-      detections->Offer({frame, timestamp, KeyframeOf(frame)->second.grey, colour.empty() ? cv::Mat() : colour.clone()});
+      detections->Offer(
+          {frame, timestamp, KeyframeOf(frame)->second.grey, colour.empty() ? cv::Mat() : colour.clone()});
     }
   }
   std::map<int, Keyframe>::iterator KeyframeOf(int frame) {
@@ -223,8 +223,8 @@ struct Odometry::Impl {
           PlaneHomography(camera, current, filter->references().at(plane.reference).world_from_cam, plane.plane);
       for (PlanePoint& m : t.members) {
         if (stats->attempted >= o.features.max_measurements) break;
-        const bool in_view = filter->PredictPlanePoint(camera, id, m.ray, &pixel, &jacobian) &&
-                             Inside(pixel, size, o.features.border);
+        const bool in_view =
+            filter->PredictPlanePoint(camera, id, m.ray, &pixel, &jacobian) && Inside(pixel, size, o.features.border);
         if (!in_view) continue;
         search(id, id, m.ray, plane.reference, h, m.keyframe_pixel, &m.history);
       }
@@ -241,7 +241,8 @@ struct Odometry::Impl {
     }
     stats->update = update.status;
     stats->measurements = static_cast<int>(std::count(update.used.begin(), update.used.end(), true));
-    for (size_t i = 0; i < update.used.size(); ++i) stats->plane_measurements += update.used[i] && !search.matches[i].ray.isZero();
+    for (size_t i = 0; i < update.used.size(); ++i)
+      stats->plane_measurements += update.used[i] && !search.matches[i].ray.isZero();
     frames_without_measurements = stats->measurements == 0 ? frames_without_measurements + 1 : 0;
   }
 
@@ -332,9 +333,9 @@ Odometry::~Odometry() = default;
 FrameStats Odometry::Track(const cv::Mat& grey, double timestamp, const cv::Mat& colour) {
   const Camera& c = impl_->camera;
   PDVO_THROW_CHECK(!grey.empty() && grey.type() == CV_8UC1, InvalidArgument, "odometry: frames must be 8-bit grey");
-  PDVO_THROW_CHECK(grey.cols == c.width && grey.rows == c.height, InvalidArgument,
-                   "odometry: the frame is " << grey.cols << "x" << grey.rows << ", the camera " << c.width << "x"
-                                             << c.height);
+  PDVO_THROW_CHECK(
+      grey.cols == c.width && grey.rows == c.height, InvalidArgument,
+      "odometry: the frame is " << grey.cols << "x" << grey.rows << ", the camera " << c.width << "x" << c.height);
   PDVO_THROW_CHECK(std::isfinite(timestamp), InvalidArgument, "odometry: the timestamp is not finite");
   PDVO_THROW_CHECK(!impl_->started || timestamp > impl_->last_time, InvalidArgument,
                    "odometry: timestamps must increase (" << impl_->last_time << " then " << timestamp << ")");
@@ -342,8 +343,8 @@ FrameStats Odometry::Track(const cv::Mat& grey, double timestamp, const cv::Mat&
   PDVO_THROW_CHECK(colour.empty() || (colour.type() == CV_8UC3 && colour.size() == grey.size()), InvalidArgument,
                    "odometry: the colour frame must be 8-bit BGR of the grey frame's size");
   FrameStats stats = impl_->Track(grey, timestamp, colour);
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() -
-                  stats.detector_wait_seconds;
+  stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - stats.detector_wait_seconds;
   return stats;
 }
 

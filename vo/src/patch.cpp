@@ -33,7 +33,8 @@ bool WarpPatch(const cv::Mat& reference, const Eigen::Matrix3d& h, const Eigen::
       if (q.z() <= 0) return false;
       const double x = q.x() / q.z(), y = q.y() / q.z();
       if (!(x >= 0 && y >= 0 && x <= reference.cols - 1 && y <= reference.rows - 1)) return false;
-      const int x0 = std::min(static_cast<int>(x), reference.cols - 2), y0 = std::min(static_cast<int>(y), reference.rows - 2);
+      const int x0 = std::min(static_cast<int>(x), reference.cols - 2),
+                y0 = std::min(static_cast<int>(y), reference.rows - 2);
       const double ax = x - x0, ay = y - y0;
       const uchar* r0 = reference.ptr<uchar>(std::max(y0, 0));
       const uchar* r1 = reference.ptr<uchar>(std::min(y0 + 1, reference.rows - 1));

@@ -60,7 +60,8 @@ void AddRegionCorners(const std::vector<cv::Point2f>& polygon, int count, const 
                cv::Scalar(0), cv::FILLED);
   }
   // Within the polygon's bounding box (with the corner detector's window of margin) only: a tenth of the cost.
-  const cv::Rect box = (cv::boundingRect(outline) + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(cv::Point(), region.size());
+  const cv::Rect box =
+      (cv::boundingRect(outline) + cv::Size(8, 8) - cv::Point(4, 4)) & cv::Rect(cv::Point(), region.size());
   if (box.empty() || cv::countNonZero(region(box)) == 0) return;
   std::vector<cv::Point2f> found;
   cv::goodFeaturesToTrack(keyframe->grey(box), found, count, kCornerQuality, features.min_distance, region(box));
@@ -79,7 +80,8 @@ double PlaneInverseDistance(const Filter& filter, const Tracks& tracks, int refe
     const Filter::Point& p = filter.points().at(id);
     if (p.reference != reference || p.inverse_depth <= 0) continue;
     const double facing = n.dot(p.ray);
-    if (facing < -min_facing && InsidePolygon(polygon, track.keyframe_pixel)) inside.push_back(-p.inverse_depth / facing);
+    if (facing < -min_facing && InsidePolygon(polygon, track.keyframe_pixel))
+      inside.push_back(-p.inverse_depth / facing);
     const double d = (track.keyframe_pixel - seed).squaredNorm();
     if (d < nearest) {
       nearest = d;
@@ -145,8 +147,8 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       ++out.near_plane;
       continue;
     }
-    const long inside =
-        std::count_if(planar.begin(), planar.end(), [&](const Eigen::Vector2d& p) { return InsidePolygon(polygon, p); });
+    const long inside = std::count_if(planar.begin(), planar.end(),
+                                      [&](const Eigen::Vector2d& p) { return InsidePolygon(polygon, p); });
     if (inside >= o.max_mapped_points) {
       ++out.mapped;
       continue;
@@ -170,8 +172,8 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       ++out.grazing;
       continue;
     }
-    const double rho_p = PlaneInverseDistance(*filter, *tracks, reference, polygon, n, seed->pixel, ray,
-                                              o.min_facing, default_inverse_depth);
+    const double rho_p = PlaneInverseDistance(*filter, *tracks, reference, polygon, n, seed->pixel, ray, o.min_facing,
+                                              default_inverse_depth);
     seed->used = true;
     const int id = filter->AddPlane(reference, {n, rho_p}, o.normal_sigma, relative_prior_sigma * rho_p);
     PlaneTrack& track = tracks->planes[id];

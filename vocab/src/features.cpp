@@ -98,7 +98,8 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
   } else {
     for (int y = o.patch_size / 2; y < grey.rows - o.patch_size / 2; y += o.grid_step) {
       for (int x = o.patch_size / 2; x < grey.cols - o.patch_size / 2; x += o.grid_step) {
-        candidates.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(o.patch_size), -1, 1.0f);
+        candidates.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(o.patch_size), -1,
+                                1.0f);
       }
     }
   }

@@ -94,7 +94,8 @@ std::vector<int> Vocabulary::Quantise(const cv::Mat& descriptors, int checks) co
 }
 
 void Vocabulary::Write(cv::FileStorage& fs, const std::string& name) const {
-  fs << name << "{" << "words" << size() << "dims" << dims();
+  fs << name << "{"
+     << "words" << size() << "dims" << dims();
   fs.writeComment("word centres, one per row");
   fs << "centres" << centres_ << "}";
 }

@@ -26,12 +26,14 @@ int main() {
   }
   const pdvo::Recogniser recogniser(pdvo::PlaneModel::Read(PDVO_MODEL));
   const pdvo::ImageWords words = recogniser.Describe(first);
-  const pdvo::RegionPrediction p = recogniser.Recognise(words, {cv::Rect(0, first.rows / 2, first.cols, first.rows / 2), {}});
-  std::printf("pdvo consumer: the lower half of the first frame is a plane with probability %.2f; %zu poses, the "
-              "last at %.3f %.3f %.3f\n",
-              p.plane_probability, odometry.trajectory().size(), odometry.world_from_cam().translation.x(),
-              odometry.world_from_cam().translation.y(), odometry.world_from_cam().translation.z());
-  const bool ok = p.valid && p.plane_probability >= 0 && p.plane_probability <= 1 && odometry.trajectory().size() == 10 &&
-                  odometry.world_from_cam().translation.allFinite();
+  const pdvo::RegionPrediction p =
+      recogniser.Recognise(words, {cv::Rect(0, first.rows / 2, first.cols, first.rows / 2), {}});
+  std::printf(
+      "pdvo consumer: the lower half of the first frame is a plane with probability %.2f; %zu poses, the "
+      "last at %.3f %.3f %.3f\n",
+      p.plane_probability, odometry.trajectory().size(), odometry.world_from_cam().translation.x(),
+      odometry.world_from_cam().translation.y(), odometry.world_from_cam().translation.z());
+  const bool ok = p.valid && p.plane_probability >= 0 && p.plane_probability <= 1 &&
+                  odometry.trajectory().size() == 10 && odometry.world_from_cam().translation.allFinite();
   return ok ? 0 : 1;
 }

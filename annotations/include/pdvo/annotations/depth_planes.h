@@ -30,23 +30,23 @@
 namespace pdvo {
 
 struct DepthPlaneOptions {
-  int working_width = 320;             // px; depth is processed at this width
-  double min_depth = 0.1;              // m; nearer readings are ignored
-  double max_depth = 6.0;              // m; farther readings are ignored
-  int normal_radius = 4;               // px at working width; local fits use (2r+1)^2 windows
-  double noise_a = 0.0012;             // m; sigma(z) = a + b (z - z0)^2
-  double noise_b = 0.0019;             // 1/m
-  double noise_z0 = 0.4;               // m
-  double inlier_sigmas = 5.0;          // point-to-plane threshold, in sigma(z)
-  double max_normal_angle_deg = 20.0;  // local normal vs plane normal, degrees
-  double seed_max_residual = 1.5;      // seeds' local RMS residual, in sigma(z)
-  double merge_angle_deg = 5.0;        // adjacent regions with normals this close may merge, degrees
-  double min_plane_fraction = 0.015;   // of the image area
-  double nonplanar_residual = 2.5;     // local RMS residual above which a pixel is non-planar, in sigma(z)
-  double nonplanar_dispersion = 0.1;   // 1 - |mean local normal| above which a pixel is non-planar
-  double min_nonplane_fraction = 0.02; // of the image area
-  double min_hole_fraction = 0.003;    // holes in a region larger than this are cut out, of the image area
-  double polygon_epsilon = 1.0;        // px at full resolution (Douglas-Peucker tolerance)
+  int working_width = 320;              // px; depth is processed at this width
+  double min_depth = 0.1;               // m; nearer readings are ignored
+  double max_depth = 6.0;               // m; farther readings are ignored
+  int normal_radius = 4;                // px at working width; local fits use (2r+1)^2 windows
+  double noise_a = 0.0012;              // m; sigma(z) = a + b (z - z0)^2
+  double noise_b = 0.0019;              // 1/m
+  double noise_z0 = 0.4;                // m
+  double inlier_sigmas = 5.0;           // point-to-plane threshold, in sigma(z)
+  double max_normal_angle_deg = 20.0;   // local normal vs plane normal, degrees
+  double seed_max_residual = 1.5;       // seeds' local RMS residual, in sigma(z)
+  double merge_angle_deg = 5.0;         // adjacent regions with normals this close may merge, degrees
+  double min_plane_fraction = 0.015;    // of the image area
+  double nonplanar_residual = 2.5;      // local RMS residual above which a pixel is non-planar, in sigma(z)
+  double nonplanar_dispersion = 0.1;    // 1 - |mean local normal| above which a pixel is non-planar
+  double min_nonplane_fraction = 0.02;  // of the image area
+  double min_hole_fraction = 0.003;     // holes in a region larger than this are cut out, of the image area
+  double polygon_epsilon = 1.0;         // px at full resolution (Douglas-Peucker tolerance)
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -75,8 +75,8 @@ struct DepthPlaneOptions {
 // A plane found in a depth map: its mask (at working resolution) and unit normal (camera frame, towards the
 // camera), with the plane's offset and fit quality.
 struct DepthPlane : PlaneMask {
-  double distance = 0;       // m; the plane is normal . x + distance = 0 (distance > 0)
-  double rms_sigmas = 0;     // RMS point-to-plane residual, in sigma(z)
+  double distance = 0;    // m; the plane is normal . x + distance = 0 (distance > 0)
+  double rms_sigmas = 0;  // RMS point-to-plane residual, in sigma(z)
 };
 
 class DepthPlaneFinder {

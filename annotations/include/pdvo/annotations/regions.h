@@ -16,14 +16,14 @@
 namespace pdvo {
 
 struct RegionSamplingOptions {
-  bool whole_shapes = true;       // each annotated polygon is a region
-  int windows_per_shape = 8;      // sub-windows tried per shape (fewer if they do not fit)
+  bool whole_shapes = true;   // each annotated polygon is a region
+  int windows_per_shape = 8;  // sub-windows tried per shape (fewer if they do not fit)
   // A sub-window's size is its geometric mean side, sqrt(width x height), log-uniform between these bounds.
-  int min_window = 40;            // px at the working resolution
+  int min_window = 40;               // px at the working resolution
   double max_window_fraction = 0.8;  // as a fraction of the image's smaller side
   // Its aspect ratio, width / height, is log-uniform in [1 / max_window_aspect, max_window_aspect] (1: squares).
   double max_window_aspect = 1;
-  double min_shape_area = 900;    // px^2 at the working resolution: smaller shapes are skipped
+  double min_shape_area = 900;  // px^2 at the working resolution: smaller shapes are skipped
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {

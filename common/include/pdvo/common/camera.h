@@ -18,10 +18,10 @@
 namespace pdvo {
 
 struct Camera {
-  int width = 0, height = 0;               // pixels
-  double fx = 0, fy = 0, cx = 0, cy = 0;   // pixels
-  std::array<double, 5> distortion{};      // k1, k2, p1, p2, k3
-  double depth_scale = 0;                  // depth image units per metre; 0: not given
+  int width = 0, height = 0;              // pixels
+  double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
+  std::array<double, 5> distortion{};     // k1, k2, p1, p2, k3
+  double depth_scale = 0;                 // depth image units per metre; 0: not given
 
   // Reads from YAML; throws IoError / FormatError naming the file and the missing or bad key.
   static Camera Read(const std::string& path);

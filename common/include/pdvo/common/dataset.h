@@ -23,12 +23,12 @@
 namespace pdvo {
 
 struct Frame {
-  size_t index = 0;          // position in the sequence
-  double timestamp = 0;      // seconds
-  cv::Mat image;             // 8-bit BGR
-  cv::Mat depth;             // CV_32F metres, 0 where unknown; empty if the sequence has no depth
+  size_t index = 0;                       // position in the sequence
+  double timestamp = 0;                   // seconds
+  cv::Mat image;                          // 8-bit BGR
+  cv::Mat depth;                          // CV_32F metres, 0 where unknown; empty if the sequence has no depth
   std::optional<Rigid3d> world_from_cam;  // ground truth, if the sequence has it near this time
-  std::string image_path;    // file the image came from (empty for video)
+  std::string image_path;                 // file the image came from (empty for video)
 };
 
 struct SequenceOptions {

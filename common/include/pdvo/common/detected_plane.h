@@ -8,10 +8,10 @@
 namespace pdvo {
 
 struct DetectedPlane {
-  std::vector<Eigen::Vector2d> polygon;  // the plane's outline, pixels of the image it was found in
-  std::vector<Eigen::Vector2d> points;   // its salient points, same pixels (may be empty)
+  std::vector<Eigen::Vector2d> polygon;              // the plane's outline, pixels of the image it was found in
+  std::vector<Eigen::Vector2d> points;               // its salient points, same pixels (may be empty)
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, that image's camera frame, towards the camera
-  double score = 1;                      // confidence in [0, 1]
+  double score = 1;                                  // confidence in [0, 1]
 };
 
 }  // namespace pdvo

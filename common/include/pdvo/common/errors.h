@@ -40,13 +40,13 @@ class InvalidArgument : public Error {
 
 // PDVO_THROW_CHECK(cond, Type, message stream): throws Type(message) when cond is false. The message is a
 // stream expression, e.g. PDVO_THROW_CHECK(n > 0, pdvo::FormatError, path << ": no poses").
-#define PDVO_THROW_CHECK(cond, Type, msg)  \
-  do {                                     \
-    if (!(cond)) {                         \
-      std::ostringstream pdvo_check_os_;   \
-      pdvo_check_os_ << msg;               \
-      throw Type(pdvo_check_os_.str());    \
-    }                                      \
+#define PDVO_THROW_CHECK(cond, Type, msg) \
+  do {                                    \
+    if (!(cond)) {                        \
+      std::ostringstream pdvo_check_os_;  \
+      pdvo_check_os_ << msg;              \
+      throw Type(pdvo_check_os_.str());   \
+    }                                     \
   } while (false)
 
 // PDVO_THROW(Type, message stream): throws unconditionally.

@@ -78,7 +78,7 @@ struct LogVoidify {
 }  // namespace pdvo::detail
 
 // PDVO_LOG(Info) << "message": the message is built only if the level is enabled.
-#define PDVO_LOG(level)                                              \
-  (::pdvo::LogLevel::k##level > ::pdvo::GetLogLevel())               \
-      ? (void)0                                                      \
+#define PDVO_LOG(level)                                \
+  (::pdvo::LogLevel::k##level > ::pdvo::GetLogLevel()) \
+      ? (void)0                                        \
       : ::pdvo::detail::LogVoidify() & ::pdvo::detail::LogMessage(::pdvo::LogLevel::k##level).stream()

@@ -44,11 +44,15 @@ struct FieldProbe {
 }  // namespace detail
 
 template <class T>
-concept OptionsStruct = requires(T& t, detail::FieldProbe& probe) { T::Fields(t, probe); };
+concept OptionsStruct = requires(T& t, detail::FieldProbe& probe) {
+  T::Fields(t, probe);
+};
 
 // An enum whose values have names (OptionNames, above).
 template <class T>
-concept OptionsEnum = std::is_enum_v<T> && requires(T t) { OptionNames(t); };
+concept OptionsEnum = std::is_enum_v<T> && requires(T t) {
+  OptionNames(t);
+};
 
 // The name of an enum value, and the value of a name (InvalidArgument naming `where` and the names if unknown).
 template <OptionsEnum T>
@@ -75,12 +79,12 @@ std::string& FailedOption();
 }  // namespace detail
 
 // In a Check(): records the failed condition (see detail::FailedOption) and returns false.
-#define PDVO_CHECK_OPTION(cond)                                                              \
-  do {                                                                                       \
-    if (!(cond)) {                                                                           \
+#define PDVO_CHECK_OPTION(cond)                                                           \
+  do {                                                                                    \
+    if (!(cond)) {                                                                        \
       if (::pdvo::detail::FailedOption().empty()) ::pdvo::detail::FailedOption() = #cond; \
-      return false;                                                                          \
-    }                                                                                        \
+      return false;                                                                       \
+    }                                                                                     \
   } while (false)
 
 namespace detail {
@@ -99,8 +103,7 @@ void ParseScalar(const std::string& text, const std::string& where, int& value);
 void ParseScalar(const std::string& text, const std::string& where, double& value);
 void ParseScalar(const std::string& text, const std::string& where, std::string& value);
 void ParseScalar(const std::string& text, const std::string& where, std::vector<double>& value);
-void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known,
-                        const std::string& where);
+void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known, const std::string& where);
 }  // namespace detail
 
 // Reads the fields of `options` from a YAML map; `where` names the file (and section) for error messages.
@@ -184,8 +187,7 @@ template <OptionsStruct T>
 void ApplyOverrides(T& options, const std::vector<std::string>& assignments) {
   for (const std::string& a : assignments) {
     const size_t eq = a.find('=');
-    PDVO_THROW_CHECK(eq != std::string::npos && eq > 0, InvalidArgument,
-                     "--set expects key=value, got '" << a << "'");
+    PDVO_THROW_CHECK(eq != std::string::npos && eq > 0, InvalidArgument, "--set expects key=value, got '" << a << "'");
     SetOption(options, a.substr(0, eq), a.substr(eq + 1));
   }
 }
@@ -234,8 +236,8 @@ void CheckOptionsOrThrow(const T& options, const std::string& what) {
   detail::MentionedValues(options, condition, "", &values);
   std::string listed;
   for (const std::string& v : values) listed += (listed.empty() ? " (" : ", ") + v;
-  PDVO_THROW(InvalidArgument, "invalid " << what << ": " << condition << " does not hold" << listed
-                                         << (listed.empty() ? "" : ")"));
+  PDVO_THROW(InvalidArgument,
+             "invalid " << what << ": " << condition << " does not hold" << listed << (listed.empty() ? "" : ")"));
 }
 
 // Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them.
@@ -243,8 +245,7 @@ template <OptionsStruct T>
 T LoadOptions(const std::string& path, const std::string& section = "") {
   cv::FileStorage fs = OpenYamlForReading(path);
   T options;
-  ReadOptions(section.empty() ? fs.root() : fs[section], options,
-              section.empty() ? path : path + ": " + section);
+  ReadOptions(section.empty() ? fs.root() : fs[section], options, section.empty() ? path : path + ": " + section);
   CheckOptionsOrThrow(options, "options in " + path);
   return options;
 }

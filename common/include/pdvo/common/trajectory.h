@@ -27,8 +27,7 @@ enum class TrajectoryFormat { kTum, kKitti };
 TrajectoryFormat ParseTrajectoryFormat(const std::string& name);
 
 // Reads a trajectory. For KITTI, `times_path` (optional) gives the timestamps; it must have one line per pose.
-Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
-                          const std::string& times_path = "");
+Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format, const std::string& times_path = "");
 // Reads one time per line (KITTI times.txt); throws on a bad line or non-increasing times.
 std::vector<double> ReadTimes(const std::string& path);
 // Writes atomically. KITTI drops the timestamps.

@@ -23,7 +23,7 @@
 namespace pdvo {
 
 struct DetectionScoreOptions {
-  int max_width = 640;           // px
+  int max_width = 640;            // px
   double min_plane_share = 0.01;  // of the image: smaller reference planes do not count for plane recall
   double match_iou = 0.5;
 };
@@ -33,12 +33,12 @@ struct DetectionScore {
   // Pixel counts on annotated pixels: reference label x detected label (plane, non-plane, none).
   long plane_as_plane = 0, plane_as_nonplane = 0, plane_as_none = 0;
   long nonplane_as_plane = 0, nonplane_as_nonplane = 0, nonplane_as_none = 0;
-  int reference_planes = 0;             // counted for plane recall
-  int matched_10 = 0, matched_30 = 0;   // of them, matched with a normal within 10 / 30 degrees
+  int reference_planes = 0;               // counted for plane recall
+  int matched_10 = 0, matched_30 = 0;     // of them, matched with a normal within 10 / 30 degrees
   std::vector<double> normal_errors_deg;  // of the reference planes matched by IoU (any angle, any size)
-  int spurious_planes = 0;              // detected planes that are no reference plane's match
+  int spurious_planes = 0;                // detected planes that are no reference plane's match
   double rand_index = 1, variation_of_information = 0, covering = 1;  // 1, 0, 1 without reference planes
-  long segmentation_pixels = 0;         // the reference plane pixels the segmentation figures are over
+  long segmentation_pixels = 0;  // the reference plane pixels the segmentation figures are over
 };
 
 // Throws InvalidArgument if the two annotations are of different image sizes.
@@ -47,14 +47,14 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
 
 struct DetectionSummary {
   int images = 0;
-  double plane_precision = 0, plane_recall = 0, plane_f1 = 0;           // over all annotated pixels
+  double plane_precision = 0, plane_recall = 0, plane_f1 = 0;  // over all annotated pixels
   double nonplane_precision = 0, nonplane_recall = 0, nonplane_f1 = 0;
   double false_plane_area = 0;
   int reference_planes = 0;
   double plane_recall_10 = 0, plane_recall_30 = 0;
-  double mean_normal_error_deg = 0, median_normal_error_deg = 0;        // over matched planes
+  double mean_normal_error_deg = 0, median_normal_error_deg = 0;  // over matched planes
   int spurious_planes = 0;
-  double rand_index = 0, variation_of_information = 0, covering = 0;    // means over images with plane pixels
+  double rand_index = 0, variation_of_information = 0, covering = 0;  // means over images with plane pixels
 };
 DetectionSummary Summarise(const std::vector<DetectionScore>& scores);
 

@@ -38,8 +38,8 @@ PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& est
 
 struct PlaneComparisonSummary {
   int frames = 0, reference_planes = 0, matched = 0;
-  double median_iou = 0, mean_iou = 0;                 // over reference planes, 0 for unmatched ones
-  double median_matched_iou = 0;                       // over matched planes only
+  double median_iou = 0, mean_iou = 0;  // over reference planes, 0 for unmatched ones
+  double median_matched_iou = 0;        // over matched planes only
   double median_normal_angle_deg = 0, mean_normal_angle_deg = 0, p90_normal_angle_deg = 0;  // over matches
 };
 

@@ -11,17 +11,17 @@
 namespace pdvo {
 
 struct RecognitionSample {
-  bool planar = false;                         // the truth
-  double probability = 0;                      // predicted plane probability
-  std::optional<Eigen::Vector3d> true_normal;  // planes with a reference normal
+  bool planar = false;                                 // the truth
+  double probability = 0;                              // predicted plane probability
+  std::optional<Eigen::Vector3d> true_normal;          // planes with a reference normal
   Eigen::Vector3d normal = Eigen::Vector3d(0, 0, -1);  // predicted
 };
 
 struct RecognitionMetrics {
   int regions = 0;
   double accuracy = 0, balanced_accuracy = 0, precision = 0, recall = 0, roc_auc = 0;
-  int confusion[2][2] = {{0, 0}, {0, 0}};  // [truth: plane, non-plane][predicted: plane, non-plane]
-  int normals = 0;                         // planes with a reference normal
+  int confusion[2][2] = {{0, 0}, {0, 0}};                     // [truth: plane, non-plane][predicted: plane, non-plane]
+  int normals = 0;                                            // planes with a reference normal
   double normal_mean = 0, normal_median = 0, normal_p90 = 0;  // degrees
 };
 

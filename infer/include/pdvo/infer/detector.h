@@ -25,25 +25,25 @@
 namespace pdvo {
 
 struct DetectorOptions {
-  int cell = 8;  // px: windows start and end on this grid
+  int cell = 8;                                       // px: windows start and end on this grid
   std::vector<double> window_sizes = {64, 112, 176};  // px: each window shape's geometric-mean side
   std::vector<double> window_aspects = {1, 2, 0.5};   // width / height of the window shapes
-  double overlap = 0.5;             // share of a window's side that the next window of its shape overlaps
+  double overlap = 0.5;              // share of a window's side that the next window of its shape overlaps
   bool fuse_window_normals = false;  // fuse each window's normal with its edges' vanishing direction (slower)
-  double normal_scale_deg = 15;     // the Cauchy scale of a point's robust mean normal
+  double normal_scale_deg = 15;      // the Cauchy scale of a point's robust mean normal
   // The graph's edges: weight = exp(-(distance / distance_scale)^2 / 2) exp(-(colour difference / colour_scale)^2
   // / 2), colours in [0, 1] per channel.
-  double distance_scale = 25;       // px
+  double distance_scale = 25;  // px
   double colour_scale = 0.15;
-  double plane_smoothness = 1.5;    // MRF 1's Potts weight on a full-weight edge
+  double plane_smoothness = 1.5;          // MRF 1's Potts weight on a full-weight edge
   double orientation_bandwidth_deg = 12;  // mean shift on the planar points' normals
   double orientation_merge_deg = 15;      // modes nearer than this are one orientation
   int max_orientations = 6;
-  double orientation_scale_deg = 20;      // MRF 2's data cost: (angle / scale)^2, at most 4
-  double orientation_smoothness = 1.5;    // MRF 2's Potts weight on a full-weight edge
-  int min_segment_points = 10;      // smaller segments are dropped
-  double min_plane_probability = 0.5;  // a plane segment recognised again below this is dropped
-  double cell_radius = 16;          // px: a segment's area is its points' Voronoi cells within this distance
+  double orientation_scale_deg = 20;    // MRF 2's data cost: (angle / scale)^2, at most 4
+  double orientation_smoothness = 1.5;  // MRF 2's Potts weight on a full-weight edge
+  int min_segment_points = 10;          // smaller segments are dropped
+  double min_plane_probability = 0.5;   // a plane segment recognised again below this is dropped
+  double cell_radius = 16;              // px: a segment's area is its points' Voronoi cells within this distance
   // The stages, for measuring what each adds. Off: a point is planar if its planarity exceeds 0.5 (MRF 1); takes
   // its nearest orientation (MRF 2); a segment's normal is its points' robust mean and its score their mean
   // planarity, and it is kept (re-recognition).
@@ -96,21 +96,21 @@ PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vect
 
 struct DetectedSegment {
   bool planar = false;
-  std::vector<int> points;          // indices into Detections::points
-  cv::Mat mask;                     // CV_8U, working size: the segment's area
+  std::vector<int> points;                           // indices into Detections::points
+  cv::Mat mask;                                      // CV_8U, working size: the segment's area
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // planes: from the segment's recognition
-  double score = 0;                 // planes: its plane probability; non-planes: 1 - the points' mean planarity
+  double score = 0;  // planes: its plane probability; non-planes: 1 - the points' mean planarity
 };
 
 struct Detections {
-  cv::Size image_size;              // working size
-  double scale = 1;                 // working width / the image's width
-  std::vector<cv::Point2f> points;  // salient points, working pixels
-  std::vector<double> planarity;    // per point, in [0, 1]; 0.5 where no window held it
-  std::vector<Eigen::Vector3d> normals;  // per point; zero where no window held it
-  std::vector<int> plane_label;     // per point: MRF 1 (1 plane, 0 not)
-  std::vector<int> orientation;     // per point: MRF 2's orientation, -1 for non-planar points
-  std::vector<DetectedWindow> windows;   // the windows recognised (with enough points)
+  cv::Size image_size;                    // working size
+  double scale = 1;                       // working width / the image's width
+  std::vector<cv::Point2f> points;        // salient points, working pixels
+  std::vector<double> planarity;          // per point, in [0, 1]; 0.5 where no window held it
+  std::vector<Eigen::Vector3d> normals;   // per point; zero where no window held it
+  std::vector<int> plane_label;           // per point: MRF 1 (1 plane, 0 not)
+  std::vector<int> orientation;           // per point: MRF 2's orientation, -1 for non-planar points
+  std::vector<DetectedWindow> windows;    // the windows recognised (with enough points)
   std::vector<DetectedSegment> segments;  // planes, then non-planes
   struct Times {
     double describe = 0, windows = 0, pooling = 0, segmentation = 0, segments = 0, total = 0;  // ms

@@ -35,11 +35,11 @@ struct RvmFunction {
 };
 
 struct RecogniserOptions {
-  int working_width = 320;    // images are resized to this width before description (0: as given)
+  int working_width = 320;  // images are resized to this width before description (0: as given)
   FeatureOptions features;
-  int min_points = 8;         // regions with fewer salient points are not recognised
-  int topic_iterations = 100; // non-negative projection onto the topics
-  VanishingOptions vanishing; // the edges' vanishing direction, fused with the regressors' normals
+  int min_points = 8;          // regions with fewer salient points are not recognised
+  int topic_iterations = 100;  // non-negative projection onto the topics
+  VanishingOptions vanishing;  // the edges' vanishing direction, fused with the regressors' normals
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -55,9 +55,9 @@ struct RecogniserOptions {
 
 // What the model was trained on and how well it did in cross-validation (filled by training).
 struct ModelCard {
-  std::string data;            // the annotation folders, as given
+  std::string data;  // the annotation folders, as given
   int images = 0;
-  int plane_regions = 0;       // used for each classifier (after balancing)
+  int plane_regions = 0;  // used for each classifier (after balancing)
   int non_plane_regions = 0;
   int normal_regions = 0;      // used for the normal regressors
   int folds = 0;               // cross-validation folds (grouped by image)
@@ -70,8 +70,8 @@ struct PlaneModel {
   RecogniserOptions options;
   Vocabulary gradient_words;
   Vocabulary colour_words;
-  Eigen::MatrixXd topics;         // (gradient words + colour words) x topics, non-negative
-  Eigen::VectorXd feature_mean;   // standardisation of the region features
+  Eigen::MatrixXd topics;        // (gradient words + colour words) x topics, non-negative
+  Eigen::VectorXd feature_mean;  // standardisation of the region features
   Eigen::VectorXd feature_scale;
   // Each member's value is a logit of the plane probability; the probability is the members' mean (see
   // Recogniser::Predict). Members are trained on different draws of the training regions (bagging).

@@ -24,12 +24,11 @@ struct ImageWords {
   std::vector<float> angle;      // radians in [0, pi), see Features::orientation
   std::vector<float> coherence;  // in [0, 1]
   cv::Size image_size;
-  EdgePlanes edges;              // straight edges (see vanishing.h)
+  EdgePlanes edges;  // straight edges (see vanishing.h)
   size_t size() const { return points.size(); }
 };
 
-ImageWords QuantiseFeatures(const Features& features, const Vocabulary& gradient_words,
-                            const Vocabulary& colour_words);
+ImageWords QuantiseFeatures(const Features& features, const Vocabulary& gradient_words, const Vocabulary& colour_words);
 
 // `image` resized to `working_width` (unchanged if 0 or already that wide); `scale` gets new / old width.
 cv::Mat ToWorkingSize(const cv::Mat& image, int working_width, double* scale = nullptr);
@@ -43,9 +42,9 @@ struct RegionWords {
   std::vector<int> orientation;  // per point, in [0, kOrientationBins)
   std::vector<float> angle;      // per point, as in ImageWords
   std::vector<float> coherence;
-  cv::Rect2d box;                // the region's extent in pixel-edge coordinates
+  cv::Rect2d box;  // the region's extent in pixel-edge coordinates
   cv::Size image_size;
-  Eigen::VectorXd histogram;     // gradient words + colour words, sums to 1 (zero if no points)
+  Eigen::VectorXd histogram;  // gradient words + colour words, sums to 1 (zero if no points)
   Eigen::Vector2d edge_structure = Eigen::Vector2d::Zero();  // see EdgeStructure; filled by the caller
   int size() const { return static_cast<int>(points.size()); }
 };
@@ -74,14 +73,14 @@ inline int RegionFeatureDims(int topics) { return 6 * (topics + kOrientationBins
 struct AnnotatedImage {
   std::string annotation_path;
   Annotation annotation;
-  cv::Mat image;  // 8-bit BGR, working size
+  cv::Mat image;                 // 8-bit BGR, working size
   std::optional<Camera> camera;  // at the working size, when the annotation gives one
 };
 // Reads, validates and resizes; throws pdvo::Error naming the file at fault (JSON or image).
 AnnotatedImage ReadAnnotatedImage(const std::string& annotation_path, int working_width);
 
 struct RegionPrediction {
-  bool valid = false;        // false: too few salient points to say
+  bool valid = false;  // false: too few salient points to say
   int points = 0;
   double plane_probability = 0;
   // Unit, camera frame, towards the camera: n . ray <= 0 for the ray through the region's centre (Recognise).

@@ -11,9 +11,9 @@
 namespace pdvo {
 
 struct Spatiogram {
-  Eigen::VectorXd weights;                  // per topic
-  std::vector<Eigen::Vector2d> means;       // per topic, normalised region coordinates; 0 without support
-  std::vector<Eigen::Matrix2d> covariances; // per topic; 0 without support
+  Eigen::VectorXd weights;                   // per topic
+  std::vector<Eigen::Vector2d> means;        // per topic, normalised region coordinates; 0 without support
+  std::vector<Eigen::Matrix2d> covariances;  // per topic; 0 without support
 
   // Per topic: weight, mean x, mean y, cov xx, cov xy, cov yy (6 values a topic), for the classifiers.
   Eigen::VectorXd ToVector() const;

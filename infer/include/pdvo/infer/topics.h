@@ -8,8 +8,7 @@ namespace pdvo {
 
 // The non-negative h minimising |histogram - basis * h|^2 (basis: words x topics, non-negative), by
 // multiplicative updates started from max(basis^T histogram, 0) + epsilon. `iterations` bounds the work.
-Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::VectorXd& histogram,
-                                  int iterations = 200);
+Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::VectorXd& histogram, int iterations = 200);
 // The same with the basis's Gram matrix basis^T basis given (for many projections onto one basis).
 Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::MatrixXd& gram,
                                   const Eigen::VectorXd& histogram, int iterations);

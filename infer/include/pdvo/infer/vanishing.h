@@ -26,20 +26,20 @@
 namespace pdvo {
 
 struct VanishingOptions {
-  bool fuse_normals = true;         // false: normals are the regressors' alone
-  double field_of_view_deg = 60;    // horizontal field of view when the camera is not known
-  double tensor_sigma = 1.5;        // px, the structure tensor's Gaussian window
-  double min_strength = 5;          // an edge's gradient, grey levels per pixel (the tensor's larger root)
-  double min_coherence = 0.4;       // ((l1 - l2) / (l1 + l2))^2 of the tensor's eigenvalues
+  bool fuse_normals = true;       // false: normals are the regressors' alone
+  double field_of_view_deg = 60;  // horizontal field of view when the camera is not known
+  double tensor_sigma = 1.5;      // px, the structure tensor's Gaussian window
+  double min_strength = 5;        // an edge's gradient, grey levels per pixel (the tensor's larger root)
+  double min_coherence = 0.4;     // ((l1 - l2) / (l1 + l2))^2 of the tensor's eigenvalues
   // Vertical edges: within this angle of the image's y axis when the vertical is found; in a region, those whose
   // line's plane is within this angle of containing the vertical (they say nothing of the azimuth).
   double vertical_band_deg = 30;
-  double max_tilt_deg = 25;         // the vertical found must be this close to the image's y axis
-  int min_edges = 20;               // per region (and 2.5x this per image for the vertical)
-  int max_edges = 2000;             // per region: more are subsampled evenly
-  double residual_scale = 0.4;      // Cauchy scale of m . d
-  double prior_weight = 0.1;        // the model's von Mises concentration, against the mean log-likelihood
-  double horizontal_cos = 0.85;     // |n . up| of the model's normal above this: a horizontal plane
+  double max_tilt_deg = 25;      // the vertical found must be this close to the image's y axis
+  int min_edges = 20;            // per region (and 2.5x this per image for the vertical)
+  int max_edges = 2000;          // per region: more are subsampled evenly
+  double residual_scale = 0.4;   // Cauchy scale of m . d
+  double prior_weight = 0.1;     // the model's von Mises concentration, against the mean log-likelihood
+  double horizontal_cos = 0.85;  // |n . up| of the model's normal above this: a horizontal plane
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -62,11 +62,11 @@ struct VanishingOptions {
 
 // An image's coherent edges as the unit normals of their lines' planes through the camera centre.
 struct EdgePlanes {
-  Camera camera;                             // the camera the planes were found with
-  cv::Mat normals;                           // CV_32FC3, image-sized; zero where there is no coherent edge
-  cv::Mat strength;                          // CV_32F, the edge's gradient (zero where none)
+  Camera camera;                                  // the camera the planes were found with
+  cv::Mat normals;                                // CV_32FC3, image-sized; zero where there is no coherent edge
+  cv::Mat strength;                               // CV_32F, the edge's gradient (zero where none)
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the vertical in the camera frame (y down: pointing down)
-  bool up_found = false;                     // false: too few vertical edges, or a tilt above max_tilt_deg
+  bool up_found = false;                          // false: too few vertical edges, or a tilt above max_tilt_deg
 };
 // `image`: 8-bit grey or BGR. `camera`: the image's, without distortion (an undistorted image's); without one,
 // Camera::WithFieldOfView with the options' field of view. Throws InvalidArgument for another image type, or a

@@ -3,8 +3,9 @@
 // its topics' spatial moments, its orientation bin's moments, its edge family's least-squares moments) is summed
 // into cells of a grid, and summed-area tables over the cells give any window aligned to the grid; edge pixels
 // are summed likewise per pixel. The topics' moments are summed over the window's cells instead: a topic's
-// membership can be tiny in a window and large elsewhere, and a table's differences would lose it. A window's feature equals RegionFeature of the window (with its EdgeStructure)
-// computed point by point, to rounding. Pixels are those of the working image.
+// membership can be tiny in a window and large elsewhere, and a table's differences would lose it. A window's feature
+// equals RegionFeature of the window (with its EdgeStructure) computed point by point, to rounding. Pixels are those of
+// the working image.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,9 +37,9 @@ class WindowFeatures {
   const PlaneModel& model_;
   Eigen::MatrixXd gram_;  // topics^T topics
   int cell_, columns_, rows_, channels_;
-  std::vector<double> table_;  // (rows + 1) x (columns + 1) x channels, summed-area over the cells
+  std::vector<double> table_;        // (rows + 1) x (columns + 1) x channels, summed-area over the cells
   std::vector<double> topic_cells_;  // rows x columns x topic channels, per cell
-  cv::Mat edge_table_;         // CV_64FC3 integral of (edge pixel, strength, vertical strength)
+  cv::Mat edge_table_;               // CV_64FC3 integral of (edge pixel, strength, vertical strength)
 };
 
 }  // namespace pdvo

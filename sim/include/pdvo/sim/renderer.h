@@ -16,11 +16,11 @@
 namespace pdvo::sim {
 
 struct RenderOptions {
-  double noise_sigma = 2.0;          // grey levels of Gaussian sensor noise
-  double exposure_variation = 0.0;   // relative amplitude of slow exposure changes (0: none)
-  int motion_blur_samples = 1;       // >1: average this many renders over the exposure
-  double exposure_fraction = 0.5;    // exposure time as a fraction of the frame interval (motion blur)
-  double texels_per_metre = 25.0;    // texture resolution
+  double noise_sigma = 2.0;         // grey levels of Gaussian sensor noise
+  double exposure_variation = 0.0;  // relative amplitude of slow exposure changes (0: none)
+  int motion_blur_samples = 1;      // >1: average this many renders over the exposure
+  double exposure_fraction = 0.5;   // exposure time as a fraction of the frame interval (motion blur)
+  double texels_per_metre = 25.0;   // texture resolution
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -55,8 +55,7 @@ class Renderer {
   // Depth, ids and the shaded image at `time` (seconds; for exposure changes and noise). With motion blur,
   // `exposure_poses` are the poses during the exposure (the last is the frame's pose, which gives depth and
   // ids); otherwise pass just the frame's pose.
-  void Render(const std::vector<Rigid3d>& exposure_poses, double time, uint64_t frame_index,
-              RenderedFrame* out) const;
+  void Render(const std::vector<Rigid3d>& exposure_poses, double time, uint64_t frame_index, RenderedFrame* out) const;
 
   const Camera& camera() const { return camera_; }
 

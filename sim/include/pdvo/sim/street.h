@@ -19,20 +19,20 @@
 namespace pdvo::sim {
 
 struct StreetOptions {
-  double min_segment_length = 25.0;  // m
-  double max_segment_length = 45.0;  // m
-  double max_turn_deg = 50.0;        // turn at each corner, degrees (alternating sides)
-  double road_width = 7.0;           // m
-  double pavement_width = 3.0;       // m
-  double min_building_width = 6.0;   // m
-  double max_building_width = 16.0;  // m
-  double min_building_height = 6.0;  // m
-  double max_building_height = 18.0; // m
-  double max_setback = 2.5;          // m, how far a facade may stand back from the pavement
-  double tree_spacing = 14.0;        // m, mean distance between trees on each side
-  double car_spacing = 18.0;         // m, mean distance between parked cars on each side
-  double pole_spacing = 25.0;        // m
-  bool loop = false;                 // a closed loop around a block instead of an open street
+  double min_segment_length = 25.0;   // m
+  double max_segment_length = 45.0;   // m
+  double max_turn_deg = 50.0;         // turn at each corner, degrees (alternating sides)
+  double road_width = 7.0;            // m
+  double pavement_width = 3.0;        // m
+  double min_building_width = 6.0;    // m
+  double max_building_width = 16.0;   // m
+  double min_building_height = 6.0;   // m
+  double max_building_height = 18.0;  // m
+  double max_setback = 2.5;           // m, how far a facade may stand back from the pavement
+  double tree_spacing = 14.0;         // m, mean distance between trees on each side
+  double car_spacing = 18.0;          // m, mean distance between parked cars on each side
+  double pole_spacing = 25.0;         // m
+  bool loop = false;                  // a closed loop around a block instead of an open street
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -83,30 +83,30 @@ struct WorldBlob {
   Material material = Material::kLeaves;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d radii = Eigen::Vector3d::Ones();
-  double yaw = 0;  // radians about the y axis
+  double yaw = 0;                                    // radians about the y axis
   Eigen::Vector3d colour = Eigen::Vector3d::Ones();  // BGR in [0, 1]
 };
 
 struct Street {
   std::vector<Eigen::Vector3d> centreline;  // points on the ground (y = 0); closed if loop
   bool loop = false;
-  std::vector<WorldPlane> planes;           // ids 0..n-1
-  std::vector<WorldBlob> blobs;             // ids 0..m-1
-  double Length() const;                    // of the centreline, metres
+  std::vector<WorldPlane> planes;  // ids 0..n-1
+  std::vector<WorldBlob> blobs;    // ids 0..m-1
+  double Length() const;           // of the centreline, metres
 };
 
 // A street long enough for a walk of `min_length` metres. The same options and seed give the same street.
 Street GenerateStreet(const StreetOptions& options, double min_length, uint64_t seed);
 
 struct WalkOptions {
-  double speed = 1.4;         // m/s
-  double fps = 30.0;          // frames per second
-  double eye_height = 1.6;    // m
-  double step_frequency = 1.9;// Hz
-  double bob = 0.025;         // m, vertical step bob
-  double sway = 0.03;         // m, lateral sway
-  double shake_deg = 0.6;     // degrees, hand-held orientation jitter
-  double lateral_offset = 0.0;// m from the centreline (positive: to the walker's right)
+  double speed = 1.4;           // m/s
+  double fps = 30.0;            // frames per second
+  double eye_height = 1.6;      // m
+  double step_frequency = 1.9;  // Hz
+  double bob = 0.025;           // m, vertical step bob
+  double sway = 0.03;           // m, lateral sway
+  double shake_deg = 0.6;       // degrees, hand-held orientation jitter
+  double lateral_offset = 0.0;  // m from the centreline (positive: to the walker's right)
   // Looking around: the gaze turns from the walking direction by up to this many degrees, slowly (a sinusoid of
   // period 12-30 s, random phase), so that some frames see the facades from the front. 0: always ahead.
   double look_deg = 0.0;

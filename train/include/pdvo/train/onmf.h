@@ -11,10 +11,10 @@
 namespace pdvo {
 
 struct OnmfOptions {
-  int topics = 20;             // columns of W
+  int topics = 20;  // columns of W
   int max_iterations = 500;
-  double tolerance = 1e-6;     // stop when the relative change of the error falls below this
-  uint64_t seed = 1;           // random non-negative initialisation
+  double tolerance = 1e-6;  // stop when the relative change of the error falls below this
+  uint64_t seed = 1;        // random non-negative initialisation
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -27,8 +27,8 @@ struct OnmfOptions {
 };
 
 struct OnmfResult {
-  Eigen::MatrixXd basis;    // W: words x topics, non-negative, unit columns, near-orthogonal
-  Eigen::MatrixXd weights;  // H: topics x regions, non-negative
+  Eigen::MatrixXd basis;       // W: words x topics, non-negative, unit columns, near-orthogonal
+  Eigen::MatrixXd weights;     // H: topics x regions, non-negative
   std::vector<double> errors;  // |X - W H|_F / |X|_F after each iteration
 };
 

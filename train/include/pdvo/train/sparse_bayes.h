@@ -17,9 +17,9 @@
 namespace pdvo {
 
 struct SparseBayesOptions {
-  double gamma = 1;            // RBF kernel exp(-gamma |x - y|^2)
-  int max_iterations = 1000;   // add / re-estimate / delete steps
-  double tolerance = 1e-6;     // stop when the best step raises the log marginal likelihood by less
+  double gamma = 1;           // RBF kernel exp(-gamma |x - y|^2)
+  int max_iterations = 1000;  // add / re-estimate / delete steps
+  double tolerance = 1e-6;    // stop when the best step raises the log marginal likelihood by less
 };
 
 // Rows of `x` are samples. The result predicts t(x) = sum_i w_i k(x, v_i) - bias (bias: a constant basis).

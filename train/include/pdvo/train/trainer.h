@@ -17,8 +17,8 @@ namespace pdvo {
 struct RvmOptions {
   // RBF kernel widths tried, gamma = value / feature dimensions (features are standardised).
   std::vector<double> gammas = {0.2, 0.5};
-  double epsilon = 1e-3;      // dlib's stopping tolerance (classifier)
-  int max_iterations = 400;   // classifier iterations; normal regressors: steps (bounds their relevance vectors)
+  double epsilon = 1e-3;     // dlib's stopping tolerance (classifier)
+  int max_iterations = 400;  // classifier iterations; normal regressors: steps (bounds their relevance vectors)
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {

@@ -12,8 +12,8 @@
 // Pixels are those of the working camera (undistorted); the first camera's frame is x right, y down, z forward.
 #pragma once
 
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -46,8 +46,8 @@ inline constexpr size_t kBootstrapInliers = 30;
 // The relative motion of two views and the triangulated inliers, in the first view's frame.
 struct TwoViewMotion {
   Rigid3d first_from_second;
-  std::vector<int> inliers;              // indices into the correspondences
-  std::vector<Eigen::Vector3d> points;   // per inlier, first view's frame, in the scale of `inverse_depth`
+  std::vector<int> inliers;             // indices into the correspondences
+  std::vector<Eigen::Vector3d> points;  // per inlier, first view's frame, in the scale of `inverse_depth`
 };
 
 // The essential matrix between corresponding pixels `first` and `second` (RANSAC, 1 px), its motion and the
@@ -60,8 +60,8 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first
 
 // What a successful bootstrap gives the odometry.
 struct BootstrapStart {
-  CameraState camera;                 // at the current frame: pose, and the mean velocities since the first
-  std::vector<DepthPrior> corners;    // the inliers in the current frame, with their inverse depths
+  CameraState camera;               // at the current frame: pose, and the mean velocities since the first
+  std::vector<DepthPrior> corners;  // the inliers in the current frame, with their inverse depths
   std::vector<std::pair<size_t, Rigid3d>> revised;  // (index given to Begin + k, world_from_cam) in between
 };
 
@@ -88,10 +88,10 @@ class TwoViewBootstrap {
   int border_;
   double min_distance_, inverse_depth_;
   bool active_ = false;
-  double time_ = 0;    // of the first frame
-  size_t index_ = 0;   // of the first frame
-  CameraState first_;  // the camera at the first frame
-  cv::Mat previous_;   // the last frame
+  double time_ = 0;                               // of the first frame
+  size_t index_ = 0;                              // of the first frame
+  CameraState first_;                             // the camera at the first frame
+  cv::Mat previous_;                              // the last frame
   std::vector<std::vector<cv::Point2f>> tracks_;  // per frame since the first, the corners still tracked
 };
 

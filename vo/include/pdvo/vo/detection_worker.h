@@ -43,13 +43,13 @@ constexpr std::array<std::pair<DetectionSchedule, const char*>, 2> OptionNames(D
 }
 
 struct DetectionResult {
-  int keyframe = -1;       // the keyframe's frame
+  int keyframe = -1;  // the keyframe's frame
   double keyframe_time = 0;
-  int started = -1;        // the frame at which the detection started (real time: the newest frame known then)
-  int delivered = -1;      // the frame at which the results were handed over
-  double seconds = 0;      // the detector's time
+  int started = -1;    // the frame at which the detection started (real time: the newest frame known then)
+  int delivered = -1;  // the frame at which the results were handed over
+  double seconds = 0;  // the detector's time
   std::vector<DetectedPlane> planes;
-  std::string error;       // the detector threw: its message (and no planes)
+  std::string error;  // the detector threw: its message (and no planes)
 };
 
 class DetectionWorker {
@@ -93,10 +93,10 @@ class DetectionWorker {
   std::optional<KeyframeImage> waiting_;
   std::deque<std::pair<int, DetectionResult>> results_;  // by job serial
   int next_serial_ = 0;
-  int frame_ = -1;                // the newest frame the tracking thread has reported
+  int frame_ = -1;  // the newest frame the tracking thread has reported
   int skipped_ = 0, timed_out_ = 0;
   bool stop_ = false;
-  std::thread thread_;            // last: started when everything else is in place
+  std::thread thread_;  // last: started when everything else is in place
 };
 
 }  // namespace pdvo::vo

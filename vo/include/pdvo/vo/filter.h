@@ -21,10 +21,10 @@ namespace pdvo::vo {
 // What became of an update. Per-frame failures are values: the filter is left as it was unless kOk.
 enum class UpdateStatus {
   kOk,
-  kNoMeasurements,   // nothing to update with
-  kNotInFront,       // a measured feature is not in front of the camera (no prediction)
-  kNotPositive,      // the innovation covariance is not positive definite (numerically)
-  kNonFinite,        // the step or the innovation is not finite
+  kNoMeasurements,  // nothing to update with
+  kNotInFront,      // a measured feature is not in front of the camera (no prediction)
+  kNotPositive,     // the innovation covariance is not positive definite (numerically)
+  kNonFinite,       // the step or the innovation is not finite
 };
 const char* ToString(UpdateStatus status);  // "ok", "no-measurements", "not-in-front", "not-positive", "non-finite"
 struct UpdateResult {
@@ -35,9 +35,9 @@ struct UpdateResult {
 
 // One pixel measurement of a point, or of one of a plane's points (given by its keyframe ray).
 struct PointMeasurement {
-  int point = -1;              // point id, or plane id
-  Eigen::Vector2d pixel;       // measured, current camera (pinhole, undistorted)
-  double sigma = 1.0;          // pixels
+  int point = -1;                                 // point id, or plane id
+  Eigen::Vector2d pixel;                          // measured, current camera (pinhole, undistorted)
+  double sigma = 1.0;                             // pixels
   Eigen::Vector3d ray = Eigen::Vector3d::Zero();  // planes: the measured point's ray (unit, reference frame)
 };
 
@@ -56,7 +56,7 @@ class Filter {
   };
   struct Plane {
     int reference = -1;
-    InversePlane plane;   // reference camera frame
+    InversePlane plane;  // reference camera frame
     int offset = 0;
   };
 

@@ -33,8 +33,8 @@ struct InversePlane {
 
 // Jacobians of a projected pixel.
 struct ProjectionJacobians {
-  Matrix26d current;     // w.r.t. the current camera's (dp, dtheta)
-  Matrix26d reference;   // w.r.t. the reference camera's (dp, dtheta)
+  Matrix26d current;              // w.r.t. the current camera's (dp, dtheta)
+  Matrix26d reference;            // w.r.t. the reference camera's (dp, dtheta)
   Eigen::Vector2d inverse_depth;  // w.r.t. a point's rho
 };
 
@@ -52,8 +52,8 @@ bool ProjectPlanePoint(const Camera& camera, const Rigid3d& world_from_current, 
 
 // The homography taking reference pixels to current pixels for points of the plane:
 // H = K (R_cr - rho_p t_cr n^T) K^-1, with (R_cr, t_cr) = current_from_ref.
-Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current,
-                                const Rigid3d& world_from_ref, const InversePlane& plane);
+Eigen::Matrix3d PlaneHomography(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
+                                const InversePlane& plane);
 // A point's patch is taken as fronto-parallel: the plane through it facing its reference camera.
 InversePlane FrontoParallel(const Eigen::Vector3d& ray, double inverse_depth);
 

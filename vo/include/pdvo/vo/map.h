@@ -19,7 +19,7 @@ struct PlaneTrack;
 struct Tracks;
 
 struct MapPlane {
-  std::vector<Eigen::Vector3d> polygon;  // world, in order around the plane's points' convex hull
+  std::vector<Eigen::Vector3d> polygon;              // world, in order around the plane's points' convex hull
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // world, unit
 };
 

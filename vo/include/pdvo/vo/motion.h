@@ -30,10 +30,10 @@ struct MotionNoise {
 };
 
 struct CameraState {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();                  // camera centre in the world
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();     // world_from_cam rotation
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();                  // world frame, per second
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();          // camera frame, rad per second
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               // camera centre in the world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // world_from_cam rotation
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();               // world frame, per second
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();       // camera frame, rad per second
 
   Rigid3d world_from_cam() const { return Rigid3d(orientation, position); }
   // The state moved by an error-state step, and the step from `other` to this (inverse of Plus).

@@ -38,9 +38,9 @@ namespace pdvo::vo {
 struct PriorOptions {
   // A new point's inverse depth at the first keyframe (later: that of the mapped point nearest in the image),
   // and its standard deviation as the same share of every prior.
-  double inverse_depth = 0.2;        // 1/m
-  double inverse_depth_sigma = 0.2;  // 1/m
-  double velocity_sigma = 0.1;       // m/s: the velocity's at each start (at rest)
+  double inverse_depth = 0.2;           // 1/m
+  double inverse_depth_sigma = 0.2;     // 1/m
+  double velocity_sigma = 0.1;          // m/s: the velocity's at each start (at rest)
   double angular_velocity_sigma = 0.5;  // rad/s: the angular velocity's at each start and after the bootstrap
 
   template <class Self, class V>
@@ -57,11 +57,11 @@ struct PriorOptions {
 // Every option of the odometry; vo/config/default.yaml lists them with their defaults.
 struct VoOptions {
   PlaneMode mode = PlaneMode::kPoints;  // where planes come from (plane_seeder.h)
-  int working_width = 320;   // px: frames are resized to this width (FramePreparer; 0: the camera's own)
+  int working_width = 320;              // px: frames are resized to this width (FramePreparer; 0: the camera's own)
   // Keyframes' poses are taken as exact once made (Filter::AddReference): updates do not move the map with the
   // camera, and the camera's covariance is relative to its keyframes. Off: reference cameras stay in the state.
   bool fixed_references = true;
-  int lost_after = 5;        // frames without any measurement before starting again
+  int lost_after = 5;  // frames without any measurement before starting again
   FeatureOptions features;
   SearchOptions search;
   RansacOptions ransac;
@@ -92,25 +92,25 @@ struct VoOptions {
 
 // A keyframe's detections as they reached the odometry (mode pdvo).
 struct DetectionEvent {
-  DetectionResult result;  // with the planes as detected
+  DetectionResult result;      // with the planes as detected
   bool keyframe_gone = false;  // its reference camera had left the filter: dropped
   SeedingOutcome seeding;
 };
 
 struct FrameStats {
   double timestamp = 0;
-  double seconds = 0;       // processing time, without detector_wait_seconds
+  double seconds = 0;                // processing time, without detector_wait_seconds
   double detector_wait_seconds = 0;  // mode pdvo, deterministic schedule: time spent waiting for the detector
-  int attempted = 0;        // features searched for
-  int measurements = 0;     // matched and used in the update
-  int points = 0;           // in the filter after the frame
+  int attempted = 0;                 // features searched for
+  int measurements = 0;              // matched and used in the update
+  int points = 0;                    // in the filter after the frame
   int planes = 0;
-  int plane_points = 0;     // points held by those planes
+  int plane_points = 0;        // points held by those planes
   int plane_measurements = 0;  // measurements of plane points used in the update
   int state_size = 0;
   bool keyframe = false;
-  bool lost = false;        // tracking failed at this frame and started again
-  bool bootstrap = false;   // the filter started again here from the two-view bootstrap
+  bool lost = false;       // tracking failed at this frame and started again
+  bool bootstrap = false;  // the filter started again here from the two-view bootstrap
   // The frame's update: kOk, kNoMeasurements (nothing matched, or no hypothesis had an inlier), or a failure
   // (the update was skipped and the filter left as predicted).
   UpdateStatus update = UpdateStatus::kNoMeasurements;
@@ -121,9 +121,9 @@ struct FrameStats {
 // was initialised (for drawing tracks and checking matches against ground truth).
 struct Observation {
   Eigen::Vector2d pixel;
-  int plane = -1;         // the plane's id, or -1 for a point
-  bool matched = false;   // the search found it
-  bool used = false;      // the update used the match (RANSAC inlier or rescued)
+  int plane = -1;        // the plane's id, or -1 for a point
+  bool matched = false;  // the search found it
+  bool used = false;     // the update used the match (RANSAC inlier or rescued)
   Eigen::Vector2d keyframe_pixel{0, 0};
   double keyframe_time = 0;  // the timestamp of the frame it was initialised in
 };

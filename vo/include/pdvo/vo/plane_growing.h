@@ -16,16 +16,16 @@ namespace pdvo::vo {
 class MapRecord;
 
 struct PlaneOptions {
-  int max_new_planes = 3;      // planes seeded per keyframe (mode idpp)
-  double grow_radius = 40;     // px in the keyframe: candidates this near a member; idpp seeds twice apart
-  int new_plane_points = 1;    // candidates a plane takes per frame (the paper's IDPP: at most 3)
-  int candidate_frames = 3;    // frames a candidate is tracked, at least, before its 3D test
-  double join_gate = 2;        // the 3D test's gate, in combined standard deviations of the inverse depths
-  int plane_grow_frames = 10;  // frames a plane has to reach min_plane_points; a candidate untested by then
-                               // stays a point
-  int min_plane_points = 4;    // a plane with fewer is not a plane (not mapped, not counted)
+  int max_new_planes = 3;           // planes seeded per keyframe (mode idpp)
+  double grow_radius = 40;          // px in the keyframe: candidates this near a member; idpp seeds twice apart
+  int new_plane_points = 1;         // candidates a plane takes per frame (the paper's IDPP: at most 3)
+  int candidate_frames = 3;         // frames a candidate is tracked, at least, before its 3D test
+  double join_gate = 2;             // the 3D test's gate, in combined standard deviations of the inverse depths
+  int plane_grow_frames = 10;       // frames a plane has to reach min_plane_points; a candidate untested by then
+                                    // stays a point
+  int min_plane_points = 4;         // a plane with fewer is not a plane (not mapped, not counted)
   double plane_sigma_normal = 0.5;  // prior standard deviation of each component of a seeded (unit) normal
-  double planarity = 0.02;     // a joining point's distance off its plane, as a share of its inverse depth
+  double planarity = 0.02;          // a joining point's distance off its plane, as a share of its inverse depth
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {

@@ -26,18 +26,18 @@ struct PdvoOptions {
   // Deterministic: frames from the start of a detection to the use of its planes. The shipped detector takes
   // about 70 ms a 320x240 image (docs/detector.md): 3 frames at 30 Hz.
   int delay_frames = 3;
-  double timeout_seconds = 10;       // deterministic: the longest wait for a detection, then go on without it
-  double min_plane_distance = 30;    // px in the keyframe (the paper)
-  double min_area = 1500;            // px^2 in the keyframe: smaller detections are not used
-  double min_score = 0;              // detections of a lower score are not used
-  int max_planes = 10;               // planes seeded per keyframe, at most: the largest detections first
+  double timeout_seconds = 10;     // deterministic: the longest wait for a detection, then go on without it
+  double min_plane_distance = 30;  // px in the keyframe (the paper)
+  double min_area = 1500;          // px^2 in the keyframe: smaller detections are not used
+  double min_score = 0;            // detections of a lower score are not used
+  int max_planes = 10;             // planes seeded per keyframe, at most: the largest detections first
   // A detection whose polygon holds this many planar points visible in the keyframe is mapped already.
   int max_mapped_points = 3;
   // The prior standard deviation of each component of a detected (unit) normal (about 9 degrees; the shipped
   // model's matched planes are 2-3 degrees off on held-out streets, more on real images: docs/detector.md).
   double normal_sigma = 0.15;
-  int new_plane_points = 10;         // candidates a detected plane takes a frame (the paper)
-  int region_corners = 60;           // new corners looked for inside each detected polygon, at most
+  int new_plane_points = 10;  // candidates a detected plane takes a frame (the paper)
+  int region_corners = 60;    // new corners looked for inside each detected polygon, at most
   // px: a plane's points are taken at least this far inside its polygon (corners cluster on the outlines, where
   // surfaces meet, and a detected outline is a few pixels off).
   double region_margin = 8;

@@ -25,8 +25,8 @@ constexpr std::array<std::pair<PlaneMode, const char*>, 3> OptionNames(PlaneMode
 }
 
 struct PlaneSeed {
-  int corner = -1;         // index into the keyframe's corners
-  Eigen::Vector3d normal;  // prior unit normal, keyframe camera frame, towards the camera
+  int corner = -1;            // index into the keyframe's corners
+  Eigen::Vector3d normal;     // prior unit normal, keyframe camera frame, towards the camera
   double sigma_normal = 0.5;  // its prior standard deviation, per component
 };
 

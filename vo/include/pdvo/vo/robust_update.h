@@ -41,7 +41,6 @@ struct RobustUpdateResult {
 // Updates `filter` robustly with `measurements` (their features must be in the filter); `rng` draws the
 // hypotheses (the same generator state and input give the same result).
 RobustUpdateResult UpdateRobustly(const Camera& camera, const RansacOptions& options,
-                                  const std::vector<PointMeasurement>& measurements, std::mt19937* rng,
-                                  Filter* filter);
+                                  const std::vector<PointMeasurement>& measurements, std::mt19937* rng, Filter* filter);
 
 }  // namespace pdvo::vo

@@ -13,10 +13,10 @@ namespace pdvo {
 struct FeatureOptions {
   // Salient points: gftt (Shi-Tomasi), fast or dense (a grid). gftt gave the best recogniser (models/README.md).
   std::string detector = "gftt";
-  int max_points = 1500;          // per image, strongest first
-  int patch_size = 16;            // px, the patch described around each point
-  int fast_threshold = 15;        // FAST intensity threshold
-  int grid_step = 8;              // px, dense detector spacing
+  int max_points = 1500;    // per image, strongest first
+  int patch_size = 16;      // px, the patch described around each point
+  int fast_threshold = 15;  // FAST intensity threshold
+  int grid_step = 8;        // px, dense detector spacing
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {

@@ -47,7 +47,8 @@ inline RenderedDepth RenderDepth(const Camera& camera, const std::vector<ScenePl
       }
       for (size_t i = 0; i < spheres.size(); ++i) {
         const Eigen::Vector3d& c = spheres[i].centre;
-        const double a = ray.squaredNorm(), b = -2 * ray.dot(c), cc = c.squaredNorm() - spheres[i].radius * spheres[i].radius;
+        const double a = ray.squaredNorm(), b = -2 * ray.dot(c),
+                     cc = c.squaredNorm() - spheres[i].radius * spheres[i].radius;
         const double disc = b * b - 4 * a * cc;
         if (disc < 0) continue;
         const double t = (-b - std::sqrt(disc)) / (2 * a);
@@ -76,9 +77,9 @@ inline Camera SceneCamera() {
 
 // A room corner: floor, back wall, left wall, and a "bush" of small spheres standing on the floor.
 inline void RoomScene(std::vector<ScenePlane>* planes, std::vector<SceneSphere>* spheres) {
-  *planes = {{Eigen::Vector3d(0, -1, 0), 1.0},                          // floor, 1 m below the camera
-             {Eigen::Vector3d(0, 0, -1), 4.0},                          // back wall, 4 m ahead
-             {Eigen::Vector3d(1, 0, -0.15).normalized(), 1.2}};         // left wall, turned a little
+  *planes = {{Eigen::Vector3d(0, -1, 0), 1.0},                   // floor, 1 m below the camera
+             {Eigen::Vector3d(0, 0, -1), 4.0},                   // back wall, 4 m ahead
+             {Eigen::Vector3d(1, 0, -0.15).normalized(), 1.2}};  // left wall, turned a little
   spheres->clear();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-0.22, 0.22);

@@ -17,8 +17,8 @@ inline std::string DataPath(const std::string& name) {
 }
 
 // In a test: skips, saying so, when the data set is absent.
-#define PDVO_REQUIRE_DATA(var, name)                                                          \
-  const std::string var = ::pdvo::test::DataPath(name);                                       \
+#define PDVO_REQUIRE_DATA(var, name)                    \
+  const std::string var = ::pdvo::test::DataPath(name); \
   if (var.empty()) GTEST_SKIP() << "data set " << name << " not found under " PDVO_TEST_DATA_DIR
 
 // A fresh, empty folder for one test, removed when the object dies.
