@@ -38,7 +38,15 @@ int RunTrain(int argc, char** argv) {
   std::ostringstream data;
   for (size_t i = 0; i < inputs.size(); ++i) data << (i ? " " : "") << inputs[i];
   PDVO_LOG(Info) << "training on " << files.size() << " annotation files";
-  const PlaneModel model = TrainModel(files, options, seed, folds, data.str());
+  PlaneModel model = TrainModel(files, options, seed, folds, data.str());
+  std::vector<std::string> assignments;
+  OptionAssignments(options, &assignments);
+  for (const std::string& a : assignments) {
+    if (!model.card.training_options.empty()) model.card.training_options += ' ';
+    model.card.training_options += a;
+  }
+  model.card.pdvo_version = kVersion;
+  model.card.git_commit = kGitHash;
   model.Write(out_path);
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);

@@ -99,7 +99,8 @@ std::string PlaneModel::ToYaml() const {
      << "{"
      << "data" << card.data << "images" << card.images << "plane_regions" << card.plane_regions << "non_plane_regions"
      << card.non_plane_regions << "normal_regions" << card.normal_regions << "folds" << card.folds << "cv_accuracy"
-     << card.cv_accuracy << "cv_normal_error_deg" << card.cv_normal_error << "seed" << card.seed << "}";
+     << card.cv_accuracy << "cv_normal_error_deg" << card.cv_normal_error << "seed" << card.seed << "training_options"
+     << card.training_options << "pdvo_version" << card.pdvo_version << "git_commit" << card.git_commit << "}";
   gradient_words.Write(fs, "gradient_words");
   colour_words.Write(fs, "colour_words");
   fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale" << ToMat(feature_scale);
@@ -144,6 +145,9 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
   m.card.cv_accuracy = static_cast<double>(card["cv_accuracy"]);
   m.card.cv_normal_error = static_cast<double>(card["cv_normal_error_deg"]);
   m.card.seed = static_cast<int>(card["seed"]);
+  m.card.training_options = static_cast<std::string>(card["training_options"]);
+  m.card.pdvo_version = static_cast<std::string>(card["pdvo_version"]);
+  m.card.git_commit = static_cast<std::string>(card["git_commit"]);
   m.gradient_words = Vocabulary::Read(fs["gradient_words"], where + ": gradient_words");
   m.colour_words = Vocabulary::Read(fs["colour_words"], where + ": colour_words");
   PDVO_THROW_CHECK(m.gradient_words.dims() == kGradientDims && m.colour_words.dims() == kColourDims, FormatError,

@@ -116,6 +116,22 @@ TEST(Options, AFailedCheckNamesTheValuesOfWholeNamesOnly) {
   EXPECT_FALSE(detail::MentionsIdentifier("iterations2 > 0", "iterations"));
 }
 
+TEST(Options, AssignmentsSetTheSameOptionsAgain) {
+  OuterOptions o;
+  o.threshold = 0.25;
+  o.enabled = false;
+  o.mode = "slow";
+  o.inner.iterations = 3;
+  o.inner.weights = {0.5, 1.5, 2.5};
+  std::vector<std::string> assignments;
+  OptionAssignments(o, &assignments);
+  EXPECT_EQ(assignments, (std::vector<std::string>{"threshold=0.25", "enabled=false", "mode=slow", "inner.iterations=3",
+                                                   "inner.weights=0.5,1.5,2.5"}));
+  OuterOptions again;
+  ApplyOverrides(again, assignments);
+  EXPECT_EQ(again, o);
+}
+
 TEST(Options, MissingFileIsAnIoError) { EXPECT_THROW(LoadOptions<OuterOptions>("/nonexistent/o.yaml"), IoError); }
 
 TEST(Options, OverridesSetNestedFields) {

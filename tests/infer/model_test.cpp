@@ -43,6 +43,9 @@ PlaneModel RandomModel() {
   m.card.data = "synthetic streets";
   m.card.images = 7;
   m.card.cv_accuracy = 0.93;
+  m.card.training_options = "seed=1 rvm.gammas=0.1,0.5";
+  m.card.pdvo_version = "0.1.0";
+  m.card.git_commit = "abc1234";
   return m;
 }
 
@@ -58,6 +61,9 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_EQ(ReadFile(path).find("data: ["), std::string::npos);
   EXPECT_EQ(back.card.data, "synthetic streets");
   EXPECT_EQ(back.card.images, 7);
+  EXPECT_EQ(back.card.training_options, "seed=1 rvm.gammas=0.1,0.5");
+  EXPECT_EQ(back.card.pdvo_version, "0.1.0");
+  EXPECT_EQ(back.card.git_commit, "abc1234");
   EXPECT_EQ(back.options, m.options);
   EXPECT_EQ(back.topics, m.topics);  // doubles round trip exactly
   std::mt19937 rng(2);

@@ -224,6 +224,31 @@ void MentionedValues(const T& options, const std::string& condition, const std::
 }
 }  // namespace detail
 
+// Every field as "a.b=value", the form --set takes (a record of the options a result was made with).
+template <OptionsStruct T>
+void OptionAssignments(const T& options, std::vector<std::string>* out, const std::string& prefix = "") {
+  auto visit = [&](const char* key, const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (OptionsStruct<Field>) {
+      OptionAssignments(field, out, prefix + key + ".");
+    } else if constexpr (OptionsEnum<Field>) {
+      out->push_back(prefix + key + "=" + OptionName(field));
+    } else if constexpr (std::is_same_v<Field, std::vector<double>>) {
+      std::string list;
+      for (const double v : field) {
+        if (!list.empty()) list += ',';
+        list += detail::ValueText(v);
+      }
+      out->push_back(prefix + key + "=" + list);
+    } else if constexpr (std::is_same_v<Field, std::string>) {
+      out->push_back(prefix + key + "=" + field);
+    } else {
+      out->push_back(prefix + key + "=" + detail::ValueText(field));
+    }
+  };
+  T::Fields(options, visit);
+}
+
 // Throws InvalidArgument if options.Check() fails, naming the options (`what`), the failed condition and the
 // values of the options it names, e.g. "invalid vo options: search.min_ncc > -1 && ... does not hold
 // (search.min_ncc = 1.5)".

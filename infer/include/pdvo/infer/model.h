@@ -64,6 +64,11 @@ struct ModelCard {
   double cv_accuracy = 0;      // one classifier (the first draw), at the chosen kernel width
   double cv_normal_error = 0;  // mean angle, degrees
   int seed = 0;
+  // What trained it: the training options ("key=value" as --set takes them, space-separated), and the pdvo
+  // version and git commit of the build (empty in models trained before they were recorded).
+  std::string training_options;
+  std::string pdvo_version;
+  std::string git_commit;
 };
 
 struct PlaneModel {
