@@ -44,7 +44,7 @@ struct TrainOptions {
   // The plane probability is the mean of this many RVM classifiers (a committee), each trained on its own draw of
   // balanced regions from all there are (bagging): one draw's classifier has few relevance vectors and moves
   // with the draw. Their kernel width is chosen by cross-validation on the first draw.
-  int classifiers = 15;  // chosen on validation streets against 5 and 25 (models/README.md)
+  int classifiers = 15;  // the committee's size
   // The layout values (see LayoutFeature) count this much more than the others in the kernel's distance: a few
   // values among ~170 would otherwise hardly move it.
   double layout_weight = 6;

@@ -11,7 +11,7 @@
 namespace pdvo {
 
 struct FeatureOptions {
-  // Salient points: gftt (Shi-Tomasi), fast or dense (a grid). gftt gave the best recogniser (models/README.md).
+  // Salient points: gftt (Shi-Tomasi), fast or dense (a grid).
   std::string detector = "gftt";
   int max_points = 1500;    // per image, strongest first
   int patch_size = 16;      // px, the patch described around each point
