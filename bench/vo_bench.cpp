@@ -211,19 +211,6 @@ int main(int argc, char** argv) {
     }
     const auto main =
         std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-    if (std::getenv("VO_BENCH_PLANES")) {
-      std::printf("plane k%d id%d:", key.first, key.second);
-      for (const auto& [pid, n] : votes) {
-        if (pid >= 0) {
-          const auto& sp = street.planes.at(pid);
-          std::printf(" [%d s%d n(%.2f %.2f %.2f) d%.1f]x%d", pid, sp.surface, sp.normal.x(), sp.normal.y(),
-                      sp.normal.z(), sp.distance, n);
-        } else {
-          std::printf(" [none]x%d", n);
-        }
-      }
-      std::printf("\n");
-    }
     if (main->first < 0) continue;
     const Eigen::Vector3d truth =
         walk.at(key.first).world_from_cam.rotation.conjugate() * street.planes.at(main->first).normal;

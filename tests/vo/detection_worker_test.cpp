@@ -86,11 +86,25 @@ TEST(DetectionWorker, InRealTimeTheTrackingThreadNeverWaits) {
 
 TEST(DetectionWorker, StopsCleanlyWithWorkInProgress) {
   for (const DetectionSchedule schedule : {DetectionSchedule::kRealTime, DetectionSchedule::kDeterministic}) {
-    DetectionWorker worker(Slow(milliseconds(30)), schedule, 2, 10);
-    worker.Offer(Keyframe(0));
-    worker.Offer(Keyframe(1));
-  }  // the destructor waits for the detection in progress and joins
-  SUCCEED();
+    std::atomic<int> started{0}, ended{0};
+    const auto start = std::chrono::steady_clock::now();
+    {
+      DetectionWorker worker(
+          [&](const KeyframeImage& k) {
+            ++started;
+            std::vector<DetectedPlane> planes = Slow(milliseconds(50))(k);
+            ++ended;
+            return planes;
+          },
+          schedule, 2, 10);
+      worker.Offer(Keyframe(0));
+      worker.Offer(Keyframe(1));  // waits, and is dropped at the stop
+      while (started == 0) std::this_thread::sleep_for(milliseconds(1));
+    }  // the destructor waits for the detection in progress and joins
+    EXPECT_EQ(started, 1);
+    EXPECT_EQ(ended, 1);  // it ended before the destructor returned
+    EXPECT_GE(std::chrono::steady_clock::now() - start, milliseconds(50));
+  }
 }
 
 TEST(DetectionWorker, ADetectorThatThrowsGivesItsMessage) {

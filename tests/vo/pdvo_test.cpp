@@ -6,6 +6,7 @@
 // ThreadSanitizer.)
 #include <gtest/gtest.h>
 
+#include <set>
 #include <stdexcept>
 
 #include "pdvo/common/errors.h"
@@ -129,25 +130,35 @@ TEST(Pdvo, LateDetectionsReachTheirOwnKeyframeOrAreDropped) {
   const Street& s = TestStreet();
   // 40 frames late: newer keyframes exist when the planes arrive, and the first keyframe's filter was replaced
   // by the two-view bootstrap's.
-  const PdvoRun r = RunPdvo(s, PdvoOptionsFor(DetectionSchedule::kDeterministic, 40), Oracle(s));
-  int restart = -1, gone = 0, reached = 0;
-  for (size_t k = 0; k < r.frames.size(); ++k) {
-    const FrameStats& f = r.frames[k];
+  Odometry odometry(s.camera, PdvoOptionsFor(DetectionSchedule::kDeterministic, 40), nullptr, Oracle(s));
+  int restart = -1, newest_keyframe = -1, gone = 0, reached = 0;
+  std::set<int> planes_before;
+  for (size_t k = 0; k < s.grey.size(); ++k) {
+    const FrameStats f = odometry.Track(s.grey[k], s.walk[k].timestamp, s.colour[k]);
     for (const DetectionEvent& e : f.detections) {
       if (restart >= e.result.keyframe) {
         EXPECT_TRUE(e.keyframe_gone) << "keyframe " << e.result.keyframe << ", restart at " << restart;
       }
       gone += e.keyframe_gone;
-      if (!e.keyframe_gone && e.seeding.seeded > 0) {
-        // Newer keyframes were made meanwhile, and the planes were still seeded: in their own keyframe, found by
-        // its frame (plane_priors_test checks that seeding lands in the keyframe it is given).
-        int newer = 0;
-        for (size_t j = e.result.keyframe + 1; j <= k; ++j) newer += r.frames[j].keyframe;
-        EXPECT_GT(newer, 0);
+      if (!e.keyframe_gone && e.seeding.seeded > 0 && newest_keyframe > e.result.keyframe) {
+        // A newer keyframe was made meanwhile; the new planes belong to the detection's keyframe: their reference
+        // camera is where the odometry was at that frame.
+        int seen = 0;
+        for (const auto& [id, p] : odometry.filter().planes()) {
+          if (planes_before.count(id)) continue;
+          EXPECT_EQ(odometry.filter().references().at(p.reference).world_from_cam.translation,
+                    odometry.trajectory().at(e.result.keyframe).world_from_cam.translation)
+              << "plane " << id;
+          ++seen;
+        }
+        EXPECT_EQ(seen, e.seeding.seeded);
         ++reached;
       }
     }
+    if (f.keyframe) newest_keyframe = static_cast<int>(k);
     if (f.bootstrap || f.lost) restart = static_cast<int>(k);
+    planes_before.clear();
+    for (const auto& [id, p] : odometry.filter().planes()) planes_before.insert(id);
   }
   EXPECT_GE(gone, 1);
   EXPECT_GE(reached, 1);
