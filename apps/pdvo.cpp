@@ -29,6 +29,7 @@ constexpr Command kCommands[] = {
     {"evaluate-detection", pdvo::apps::RunEvaluateDetection, "score detections against reference annotations"},
     {"vo", pdvo::apps::RunVo, "monocular visual odometry over a sequence, with detected planes as priors (PDVO)"},
     {"ate", pdvo::apps::RunAte, "absolute and relative trajectory error after SE(3)/Sim(3) alignment"},
+    {"report", pdvo::apps::RunReport, "one HTML page of vo runs: Table I, plots, detections, the planar map in 3D"},
 };
 
 void PrintUsage(std::ostream& out) {

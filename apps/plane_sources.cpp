@@ -3,10 +3,12 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <opencv2/imgcodecs.hpp>
 #include <vector>
 
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/infer/detection_drawing.h"
 #include "pdvo/infer/detector.h"
 #include "tool.h"
 
@@ -19,8 +21,10 @@ struct PlaneSource::Impl {
   std::string description;
   std::unique_ptr<Detector> detector;                       // model
   std::map<std::string, std::vector<DetectedPlane>> files;  // folder, oracle: by image stem
-  std::mutex mutex;                                         // guards names
+  std::mutex mutex;                                         // guards names and stages
   std::vector<std::string> names;                           // by frame: image stems
+  bool keep_stages = false;
+  std::map<int, std::vector<unsigned char>> stages;  // by keyframe frame: JPEG
 
   void ReadFolder(const std::string& folder) {
     for (const std::string& path : ListAnnotationFiles({folder})) {
@@ -63,7 +67,20 @@ vo::PlaneDetector PlaneSource::detector() {
   if (impl->detector) {
     return [impl](const vo::KeyframeImage& k) {
       const cv::Mat& image = k.colour.empty() ? k.grey : k.colour;
-      return impl->detector->Detect(image, impl->working).Planes(image.cols, image.rows);
+      const Detections d = impl->detector->Detect(image, impl->working);
+      bool keep = false;
+      {
+        std::lock_guard<std::mutex> lock(impl->mutex);
+        keep = impl->keep_stages;
+      }
+      if (keep) {  // drawn without the lock: the tracking thread takes it for every frame
+        std::vector<unsigned char> jpeg;
+        const cv::Mat stages = DrawDetectionStages(image, d, d.ToAnnotation("", image.cols, image.rows, impl->working));
+        cv::imencode(".jpg", stages, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85});
+        std::lock_guard<std::mutex> lock(impl->mutex);
+        impl->stages[k.frame] = std::move(jpeg);
+      }
+      return d.Planes(image.cols, image.rows);
     };
   }
   return [impl](const vo::KeyframeImage& k) {
@@ -75,6 +92,16 @@ vo::PlaneDetector PlaneSource::detector() {
     const auto found = impl->files.find(name);
     return found == impl->files.end() ? std::vector<DetectedPlane>() : found->second;
   };
+}
+
+void PlaneSource::KeepStages() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->keep_stages = impl_->detector != nullptr;
+}
+
+std::map<int, std::vector<unsigned char>> PlaneSource::TakeStages() {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return std::move(impl_->stages);
 }
 
 std::string PlaneSource::Describe() const { return impl_->description; }

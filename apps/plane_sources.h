@@ -7,8 +7,10 @@
 //           perfect detector would give.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pdvo/common/camera.h"
 #include "pdvo/vo/detection_worker.h"
@@ -28,6 +30,10 @@ class PlaneSource {
   void AddFrame(int index, const std::string& image_path);
   // The detector for the odometry; it refers to this object, which must outlive the odometry.
   vo::PlaneDetector detector();
+  // From now on, for source "model": keep a picture of the detector's stages (infer/detection_drawing.h) of
+  // each keyframe it detects, JPEG-encoded, by the keyframe's frame index; TakeStages hands them over.
+  void KeepStages();
+  std::map<int, std::vector<unsigned char>> TakeStages();
   std::string Describe() const;
 
  private:

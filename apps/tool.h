@@ -70,5 +70,6 @@ int RunEvaluate(int argc, char** argv);
 int RunVo(int argc, char** argv);
 int RunDetect(int argc, char** argv);
 int RunEvaluateDetection(int argc, char** argv);
+int RunReport(int argc, char** argv);
 
 }  // namespace pdvo::apps

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -21,22 +22,43 @@
 namespace pdvo::apps {
 namespace {
 
+// stats.json's plane_measurements_after_keyframe: frames 0 .. kCurveFrames - 1 after a plane's keyframe.
+constexpr int kCurveFrames = 60;
+
+std::string FrameName(size_t frame) {
+  char name[16];
+  std::snprintf(name, sizeof(name), "%06zu", frame);
+  return name;
+}
+
+cv::Scalar PlaneColour(int id) {
+  return cv::Scalar(60 + (id * 67) % 196, 60 + (id * 131) % 196, 60 + (id * 199) % 196);
+}
+
+std::vector<cv::Point> Pixels(const std::vector<Eigen::Vector2d>& polygon) {
+  std::vector<cv::Point> out;
+  for (const Eigen::Vector2d& q : polygon) out.emplace_back(cvRound(q.x()), cvRound(q.y()));
+  return out;
+}
+
 // The frame with its features: points green, plane points in a colour per plane; filled where the update used
-// the match, hollow where the search failed, red where RANSAC rejected the match. The polygons of the newest
-// detections (keyframe pixels) in yellow.
+// the match, hollow where the search failed, red where RANSAC rejected the match. Each plane's region (its
+// points' hull, carried through the plane) tinted in its colour, and a detected plane's polygon in yellow.
 cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& observations, const vo::FrameStats& s,
-                    const std::vector<DetectedPlane>& detected) {
-  cv::Mat out = colour.clone();
-  for (const DetectedPlane& p : detected) {
-    std::vector<cv::Point> outline;
-    for (const Eigen::Vector2d& q : p.polygon) outline.emplace_back(cvRound(q.x()), cvRound(q.y()));
-    cv::polylines(out, std::vector<std::vector<cv::Point>>{outline}, true, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
+                    const std::vector<vo::Odometry::PlaneOutline>& planes) {
+  cv::Mat out = colour.clone(), tint = colour.clone();
+  for (const vo::Odometry::PlaneOutline& p : planes) {
+    if (p.region.size() >= 3) cv::fillConvexPoly(tint, Pixels(p.region), PlaneColour(p.id), cv::LINE_AA);
+  }
+  cv::addWeighted(out, 0.6, tint, 0.4, 0, out);
+  for (const vo::Odometry::PlaneOutline& p : planes) {
+    if (p.region.size() >= 3) cv::polylines(out, {Pixels(p.region)}, true, PlaneColour(p.id), 1, cv::LINE_AA);
+    if (p.detected.size() >= 3) cv::polylines(out, {Pixels(p.detected)}, true, cv::Scalar(0, 220, 255), 1, cv::LINE_AA);
   }
   for (const vo::Observation& o : observations) {
-    const cv::Scalar c =
-        o.matched && !o.used ? cv::Scalar(0, 0, 255)
-        : o.plane < 0        ? cv::Scalar(0, 220, 0)
-                      : cv::Scalar(60 + (o.plane * 67) % 196, 60 + (o.plane * 131) % 196, 60 + (o.plane * 199) % 196);
+    const cv::Scalar c = o.matched && !o.used ? cv::Scalar(0, 0, 255)
+                         : o.plane < 0        ? cv::Scalar(0, 220, 0)
+                                              : PlaneColour(o.plane);
     cv::circle(out, cv::Point(cvRound(o.pixel.x()), cvRound(o.pixel.y())), 3, c, o.used ? cv::FILLED : 1, cv::LINE_AA);
   }
   char text[128];
@@ -102,7 +124,9 @@ int RunVo(int argc, char** argv) {
   app.add_flag("--overlay", overlay,
                "Also write overlay.avi: each frame with its features (points green, plane points coloured by "
                "plane; filled where the update used the match, hollow where not found, red where RANSAC "
-               "rejected it) and a status line");
+               "rejected it), each plane's region tinted, detected outlines in yellow, and a status line; the "
+               "same frames as views/FRAME.jpg where detections were applied (other modes: at keyframes); in "
+               "mode pdvo with the model, the detector's stages of each keyframe as stages/FRAME.jpg");
   AddConfigFlags(app, &config_path, &overrides, "VO options (YAML, section 'vo')", "search.min_ncc=0.85");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
@@ -131,7 +155,9 @@ int RunVo(int argc, char** argv) {
   SaveOptions(out.path("vo.yaml"), options, "vo");
   size_t tracked = 0;
   nlohmann::json frames = nlohmann::json::array(), detections = nlohmann::json::array();
-  std::vector<DetectedPlane> newest_detections;  // for the overlay
+  // The paper's Fig. 4; planes are matched to their keyframe's frame by its timestamp.
+  vo::MeasurementCurve measured_after(kCurveFrames, options.planes.min_plane_points);
+  std::vector<double> times;
   int keyframes_gone = 0;
   double seconds = 0, waited = 0;
   int lost = 0, keyframes = 0, update_failures = 0;
@@ -141,6 +167,8 @@ int RunVo(int argc, char** argv) {
   if (overlay) {
     video.open(out.path("overlay.avi"), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, cv::Size(width, height));
     PDVO_THROW_CHECK(video.isOpened(), IoError, out.final_path("overlay.avi") << ": cannot open a video writer");
+    std::filesystem::create_directories(out.path("views"));
+    if (planes) planes->KeepStages();
   }
   Frame frame;
   while ((max_frames == 0 || tracked < max_frames) && sequence->Next(&frame)) {
@@ -148,17 +176,23 @@ int RunVo(int argc, char** argv) {
                      frame.image_path << ": image is " << frame.image.cols << "x" << frame.image.rows
                                       << ", the camera says " << camera.width << "x" << camera.height);
     const vo::PreparedFrame prepared = preparer.Prepare(frame.image);
-    if (planes) planes->AddFrame(static_cast<int>(tracked), frame.image_path);
+    const size_t index = tracked++;
+    if (planes) planes->AddFrame(static_cast<int>(index), frame.image_path);
     const vo::FrameStats s = odometry.Track(prepared.grey, frame.timestamp, prepared.colour);
     for (const vo::DetectionEvent& e : s.detections) {
       detections.push_back(DetectionJson(e, frame.timestamp));
       keyframes_gone += e.keyframe_gone;
-      if (e.result.error.empty()) newest_detections = e.result.planes;
+    }
+    times.push_back(frame.timestamp);
+    for (const vo::Observation& o : odometry.observations()) {
+      if (o.plane < 0) continue;
+      const int keyframe =
+          static_cast<int>(std::lower_bound(times.begin(), times.end(), o.keyframe_time) - times.begin());
+      measured_after.Add(static_cast<int>(index), keyframe, o.plane, o.keyframe_pixel, o.used);
     }
     seconds += s.seconds;
     lost += s.lost;
     keyframes += s.keyframe;
-    ++tracked;
     waited += s.detector_wait_seconds;
     frames.push_back({{"t", s.timestamp},
                       {"seconds", s.seconds},
@@ -174,7 +208,14 @@ int RunVo(int argc, char** argv) {
                       {"bootstrap", s.bootstrap},
                       {"update", vo::ToString(s.update)}});
     update_failures += s.update != vo::UpdateStatus::kOk && s.update != vo::UpdateStatus::kNoMeasurements;
-    if (overlay) video.write(DrawOverlay(prepared.colour, odometry.observations(), s, newest_detections));
+    if (overlay) {
+      const cv::Mat drawn = DrawOverlay(prepared.colour, odometry.observations(), s, odometry.plane_outlines());
+      video.write(drawn);
+      if (pdvo ? !s.detections.empty() : s.keyframe) {
+        const std::string view = out.path("views/" + FrameName(index) + ".jpg");
+        PDVO_THROW_CHECK(cv::imwrite(view, drawn), IoError, out.final_path("views") << ": cannot write a view");
+      }
+    }
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
                      std::to_string(s.planes) + " planes");
     progress.Step();
@@ -190,6 +231,13 @@ int RunVo(int argc, char** argv) {
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const vo::Map map = odometry.map();
   vo::WritePly(out.path("map.ply"), map, trajectory);
+  if (planes) {
+    const std::map<int, std::vector<unsigned char>> stages = planes->TakeStages();
+    if (!stages.empty()) std::filesystem::create_directories(out.path("stages"));
+    for (const auto& [keyframe, jpeg] : stages) {
+      WriteFileAtomically(out.path("stages/" + FrameName(keyframe) + ".jpg"), std::string(jpeg.begin(), jpeg.end()));
+    }
+  }
   const double fps = trajectory.size() / std::max(seconds, 1e-9);
   const vo::MappingStats mapping = odometry.mapping();
   const nlohmann::json totals = {{"frames", trajectory.size()},
@@ -203,7 +251,11 @@ int RunVo(int argc, char** argv) {
                                  {"mean_plane_area_px", mapping.mean_plane_area},
                                  {"map_points", map.points.size()},
                                  {"map_planes", map.planes.size()}};
-  nlohmann::json stats = {{"totals", totals}, {"frames", frames}};
+  nlohmann::json stats = {{"sequence", sequence_path},
+                          {"mode", OptionName(options.mode)},
+                          {"totals", totals},
+                          {"plane_measurements_after_keyframe", measured_after.Mean()},
+                          {"frames", frames}};
   if (pdvo) {
     const vo::Odometry::DetectionCounts counts = odometry.detection_counts();
     int detected = 0, seeded = 0;

@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
   std::vector<double> frame_cpu;  // the tracking thread's CPU time per frame
   // Per plane (keyframe, id): its used measurements by frames since its keyframe (the paper's Fig. 4).
   constexpr int kCurveFrames = 90;
-  std::map<std::pair<int, int>, std::array<int, kCurveFrames>> measured_after;
+  pdvo::vo::MeasurementCurve measured_after(kCurveFrames, vo_options.planes.min_plane_points);
   for (size_t k = 0; k < grey.size(); ++k) {
     const double frame_start = ThreadSeconds();
     const pdvo::vo::FrameStats s = odometry.Track(grey[k], walk[k].timestamp, pdvo_mode ? colour[k] : cv::Mat());
@@ -162,12 +162,7 @@ int main(int argc, char** argv) {
       if (o.plane >= 0) {
         const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
         members.push_back({static_cast<int>(k), o.plane, keyframe, o.keyframe_pixel});
-        const int age = static_cast<int>(k) - keyframe;
-        if (o.used && age >= 0 && age < kCurveFrames) {
-          auto [it, added] = measured_after.try_emplace({keyframe, o.plane});
-          if (added) it->second.fill(0);
-          ++it->second[age];
-        }
+        measured_after.Add(static_cast<int>(k), keyframe, o.plane, o.keyframe_pixel, o.used);
         const auto plane = odometry.filter().planes().find(o.plane);
         if (plane != odometry.filter().planes().end()) {
           normals[{keyframe, o.plane}] = plane->second.plane.normal.normalized();
@@ -219,14 +214,7 @@ int main(int argc, char** argv) {
   }
   std::sort(normal_errors.begin(), normal_errors.end());
   // The mean plane's measurements by frames since its keyframe, over the planes of min_plane_points or more.
-  std::array<double, kCurveFrames> curve{};
-  int curve_planes = 0;
-  for (const auto& [key, counts] : measured_after) {
-    if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points) continue;
-    ++curve_planes;
-    for (int a = 0; a < kCurveFrames; ++a) curve[a] += counts[a];
-  }
-  for (double& c : curve) c /= std::max(1, curve_planes);
+  const std::vector<double> curve = measured_after.Mean();
   long plane_members = 0;
   const double pure = purity.Share(4, &plane_members);
   std::printf("vo_bench: %d frames 320x240, seed %llu, mode %s, path %.1f m\n", frames,

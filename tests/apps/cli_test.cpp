@@ -78,7 +78,8 @@ TEST(Cli, UsageAndHelp) {
   EXPECT_EQ(help.code, 0);
   EXPECT_NE(help.out.find("annotate-depth"), std::string::npos);
   EXPECT_EQ(Pdvo("frobnicate", dir).code, 1);
-  for (const char* command : {"show", "validate", "annotate-depth", "compare", "ate", "detect", "evaluate-detection"}) {
+  for (const char* command :
+       {"show", "validate", "annotate-depth", "compare", "ate", "detect", "evaluate-detection", "report"}) {
     const CommandResult r = Pdvo(std::string(command) + " --help", dir);
     EXPECT_EQ(r.code, 0) << command;
     EXPECT_NE(r.out.find("--verbosity"), std::string::npos) << command;
@@ -223,6 +224,20 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   }
   expect_error("vo -v warning -s " + (dir / "s") + " -o " + (dir / "o3"), "000007.png");
   for (const char* o : {"o1", "o2", "o3"}) EXPECT_FALSE(fs::exists(dir / o)) << o << ": no partial output";
+
+  // The run's report, and reports of runs that are not there or not whole (the page itself: report_test.cpp).
+  const CommandResult report = Pdvo("report " + (dir / "out") + " -o " + (dir / "report.html"), dir);
+  ASSERT_EQ(report.code, 0) << report.err;
+  EXPECT_NE(ReadFile(dir / "report.html").find("\"frames\":20"), std::string::npos);
+  expect_error("report " + (dir / "nothing") + " -o " + (dir / "r1.html"), "nothing/stats.json");
+  fs::create_directories(dir / "broken");
+  fs::copy_file(dir / "out/trajectory.txt", dir / "broken/trajectory.txt");
+  WriteFileAtomically(dir / "broken/stats.json", "{\"totals\": {\"frames\": 20}, \"frames\": []}");
+  expect_error("report " + (dir / "broken") + " -o " + (dir / "r2.html"), "broken/stats.json");
+  WriteFileAtomically(dir / "broken/stats.json", ReadFile(dir / "out/stats.json"));
+  expect_error("report " + (dir / "broken") + " -o " + (dir / "r3.html"), "broken/map.ply");
+  expect_error("report " + (dir / "out") + " -o " + (dir / "r4.html") + " --js-dir " + (dir / "nojs"), "three.min.js");
+  for (const char* r : {"r1.html", "r2.html", "r3.html", "r4.html"}) EXPECT_FALSE(fs::exists(dir / r)) << r;
 }
 
 // pdvo detect on a synthetic street: one valid annotation per image, with scored planes; the same run gives the

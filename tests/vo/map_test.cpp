@@ -5,6 +5,7 @@
 
 #include <sstream>
 
+#include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/test/support.h"
 
@@ -39,6 +40,58 @@ TEST(Map, WritesPointsPlanesAndPathAsPly) {
   EXPECT_EQ(body[8], "3 2 3 4");          // the plane's face: its three corners
   EXPECT_EQ(body[9], "5 6");              // the path's first step
   EXPECT_EQ(body[10], "6 7");
+
+  std::vector<Eigen::Vector3d> read_path;
+  const Map read = ReadPly(dir / "map.ply", &read_path);
+  ASSERT_EQ(read.points.size(), 2u);
+  EXPECT_EQ(read.points[1], map.points[1]);
+  ASSERT_EQ(read.planes.size(), 1u);
+  ASSERT_EQ(read.planes[0].polygon.size(), 3u);
+  EXPECT_EQ(read.planes[0].polygon[2], plane.polygon[2]);
+  EXPECT_LT((read.planes[0].normal - plane.normal).norm(), 0.01);
+  ASSERT_EQ(read_path.size(), 3u);
+  EXPECT_EQ(read_path[2], Eigen::Vector3d(2, 0, 0));
+}
+
+TEST(Map, ReadsAPathOfOnePoseAndRefusesMalformedFiles) {
+  const test::TempDir dir;
+  Map map;
+  map.points = {Eigen::Vector3d(1, 2, 3)};
+  WritePly(dir / "one.ply", map, {{0.0, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(4, 5, 6))}});
+  std::vector<Eigen::Vector3d> path;
+  const Map read = ReadPly(dir / "one.ply", &path);
+  ASSERT_EQ(read.points.size(), 1u);
+  ASSERT_EQ(path.size(), 1u);
+  EXPECT_EQ(path[0], Eigen::Vector3d(4, 5, 6));
+
+  WriteFileAtomically(dir / "short.ply", ReadFile(dir / "one.ply").substr(0, ReadFile(dir / "one.ply").size() - 8));
+  EXPECT_THROW(ReadPly(dir / "short.ply", &path), FormatError);
+  WriteFileAtomically(dir / "text.ply", "hello\n");
+  EXPECT_THROW(ReadPly(dir / "text.ply", &path), FormatError);
+  EXPECT_THROW(ReadPly(dir / "missing.ply", &path), IoError);
+}
+
+TEST(Map, MeasurementCurveAveragesThePlanesThatReachedTheirPoints) {
+  MeasurementCurve curve(3, 2);
+  // Plane 1 of the keyframe at frame 0: two distinct pixels; used twice at age 0, once at age 2.
+  curve.Add(0, 0, 1, {1, 1}, true);
+  curve.Add(0, 0, 1, {5, 5}, true);
+  curve.Add(1, 0, 1, {5, 5}, false);  // searched for, not used
+  curve.Add(2, 0, 1, {5.2, 4.9}, true);
+  // Plane 1 of the keyframe at frame 3 (ids start again per keyframe here): one pixel only, left out.
+  curve.Add(3, 3, 1, {2, 2}, true);
+  // Plane 2: two pixels; used once at age 1, and at age 5, beyond the curve.
+  curve.Add(1, 0, 2, {1, 1}, true);
+  curve.Add(1, 0, 2, {9, 9}, false);
+  curve.Add(5, 0, 2, {1, 1}, true);
+  // Plane 3: never used within the curve's frames, left out.
+  curve.Add(7, 0, 3, {1, 1}, true);
+  curve.Add(7, 0, 3, {2, 2}, true);
+  const std::vector<double> mean = curve.Mean();
+  ASSERT_EQ(mean.size(), 3u);
+  EXPECT_DOUBLE_EQ(mean[0], 1.0);
+  EXPECT_DOUBLE_EQ(mean[1], 0.5);
+  EXPECT_DOUBLE_EQ(mean[2], 0.5);
 }
 
 }  // namespace

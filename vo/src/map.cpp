@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/vo/filter.h"
 #include "pdvo/vo/tracks.h"
@@ -46,9 +47,15 @@ bool PlaneInWorld(const Filter& filter, int id, const PlaneTrack& t, int min_poi
   return true;
 }
 
+std::vector<Eigen::Vector2d> PlaneHull(const PlaneTrack& t) {
+  std::vector<Eigen::Vector2d> hull;
+  for (int k : Hull(t.members)) hull.push_back(t.members[k].keyframe_pixel);
+  return hull;
+}
+
 double PlaneArea(const PlaneTrack& t) {
   std::vector<cv::Point2f> corners;
-  for (int k : Hull(t.members)) corners.emplace_back(t.members[k].keyframe_pixel.x(), t.members[k].keyframe_pixel.y());
+  for (const Eigen::Vector2d& q : PlaneHull(t)) corners.emplace_back(q.x(), q.y());
   return corners.size() < 3 ? 0.0 : cv::contourArea(corners);
 }
 
@@ -86,6 +93,27 @@ MappingStats MapRecord::stats() const {
     m.mean_plane_area /= m.planes;
   }
   return m;
+}
+
+void MeasurementCurve::Add(int frame, int keyframe, int plane, const Eigen::Vector2d& keyframe_pixel, bool used) {
+  Counts& c = planes_[{keyframe, plane}];
+  c.members.insert({cvRound(keyframe_pixel.x()), cvRound(keyframe_pixel.y())});
+  const int age = frame - keyframe;
+  if (!used || age < 0 || age >= frames_) return;
+  if (c.used.empty()) c.used.assign(frames_, 0);
+  ++c.used[age];
+}
+
+std::vector<double> MeasurementCurve::Mean() const {
+  std::vector<double> mean(frames_, 0.0);
+  int planes = 0;
+  for (const auto& [key, c] : planes_) {
+    if (c.used.empty() || static_cast<int>(c.members.size()) < min_plane_points_) continue;
+    ++planes;
+    for (int a = 0; a < frames_; ++a) mean[a] += c.used[a];
+  }
+  for (double& m : mean) m /= std::max(1, planes);
+  return mean;
 }
 
 Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points) {
@@ -133,6 +161,57 @@ void WritePly(const std::string& path, const Map& map, const Trajectory& camera_
   }
   for (size_t k = 0; k < edges; ++k) out << next + k << " " << next + k + 1 << "\n";
   WriteFileAtomically(path, out.str());
+}
+
+Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path) {
+  std::istringstream in(ReadFile(path));
+  std::string line, word;
+  size_t vertices = 0, faces = 0, edges = 0;
+  PDVO_THROW_CHECK(std::getline(in, line) && line == "ply", FormatError, path << ": not a PLY file");
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream header(line);
+    std::string kind;
+    size_t count = 0;
+    if (header >> word >> kind >> count && word == "element") {
+      (kind == "vertex" ? vertices : kind == "face" ? faces : edges) = count;
+    } else if (line.rfind("format", 0) == 0) {
+      PDVO_THROW_CHECK(line == "format ascii 1.0", FormatError, path << ": not an ASCII PLY file");
+    }
+  }
+  PDVO_THROW_CHECK(in, FormatError, path << ": no end_header");
+  struct Vertex {
+    Eigen::Vector3d x;
+    Eigen::Vector3i rgb;
+  };
+  std::vector<Vertex> v(vertices);
+  for (Vertex& p : v) {
+    PDVO_THROW_CHECK(in >> p.x.x() >> p.x.y() >> p.x.z() >> p.rgb.x() >> p.rgb.y() >> p.rgb.z() && p.x.allFinite(),
+                     FormatError, path << ": a vertex is malformed or missing (" << vertices << " declared)");
+  }
+  Map map;
+  std::vector<bool> in_face(vertices, false);
+  for (size_t f = 0; f < faces; ++f) {
+    size_t n = 0;
+    PDVO_THROW_CHECK(in >> n && n >= 3, FormatError, path << ": face " << f << " is malformed");
+    MapPlane& plane = map.planes.emplace_back();
+    for (size_t k = 0; k < n; ++k) {
+      size_t i = 0;
+      PDVO_THROW_CHECK(in >> i && i < vertices, FormatError, path << ": face " << f << " is malformed");
+      plane.polygon.push_back(v[i].x);
+      in_face[i] = true;
+      if (k == 0) plane.normal = (v[i].rgb.cast<double>() / 127.5 - Eigen::Vector3d::Ones()).normalized();
+    }
+  }
+  // The camera path comes last: the vertices of its edges, or a single red one.
+  size_t cameras = edges > 0 ? edges + 1 : 0;
+  if (edges == 0 && vertices > 0 && !in_face.back() && v.back().rgb == Eigen::Vector3i(255, 0, 0)) cameras = 1;
+  PDVO_THROW_CHECK(cameras <= vertices, FormatError, path << ": more path edges than vertices");
+  camera_path->clear();
+  for (size_t i = vertices - cameras; i < vertices; ++i) camera_path->push_back(v[i].x);
+  for (size_t i = 0; i < vertices - cameras; ++i) {
+    if (!in_face[i]) map.points.push_back(v[i].x);
+  }
+  return map;
 }
 
 }  // namespace pdvo::vo

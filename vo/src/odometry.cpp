@@ -361,6 +361,32 @@ Map Odometry::map() const {
 
 const std::vector<Observation>& Odometry::observations() const { return impl_->observations; }
 
+std::vector<Odometry::PlaneOutline> Odometry::plane_outlines() const {
+  std::vector<PlaneOutline> out;
+  if (!impl_->started) return out;
+  const Filter& f = *impl_->filter;
+  const Camera& camera = impl_->camera;
+  const Rigid3d cam_from_world = f.camera().world_from_cam().Inverse();
+  for (const auto& [id, track] : impl_->tracks.planes) {
+    const Filter::Plane& plane = f.planes().at(id);
+    const Rigid3d cam_from_ref = cam_from_world * f.references().at(plane.reference).world_from_cam;
+    // Keyframe pixels through the plane into the current frame.
+    auto carry = [&](const std::vector<Eigen::Vector2d>& pixels) {
+      std::vector<Eigen::Vector2d> seen;
+      for (const Eigen::Vector2d& q : pixels) {
+        const Eigen::Vector3d ray = camera.Ray(q);
+        const double rho = plane.plane.InverseDepthAlong(ray);
+        if (rho <= 0) continue;
+        const Eigen::Vector3d x = cam_from_ref * (ray / rho);
+        if (x.z() > 1e-6) seen.push_back(camera.Project(x));
+      }
+      return seen;
+    };
+    out.push_back({id, carry(PlaneHull(track)), carry(track.outline)});
+  }
+  return out;
+}
+
 Odometry::DetectionCounts Odometry::detection_counts() const {
   if (!impl_->detections) return {};
   return {impl_->detections->skipped(), impl_->detections->timed_out(), impl_->detections_failed};

@@ -180,6 +180,7 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
     track.members.push_back({seed->pixel, ray, {}});
     track.detected = true;
     track.region_corners = std::move(region);
+    track.outline = detected.polygon;
     track.new_points = o.new_plane_points;
     // The keyframe's points inside the polygon have been tracked since the keyframe: candidates at once.
     for (const auto& [point, p] : tracks->points) {

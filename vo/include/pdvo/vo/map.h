@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,12 +48,31 @@ struct MappingStats {
 
 // The share of its inverse depth within which a point's is known (one standard deviation) for it to be mapped.
 inline constexpr double kMappedRelativeSigma = 0.3;
+// The paper's Fig. 4: a plane's measurements per frame by the frames since the keyframe it was made in, the mean
+// over the planes that reached `min_plane_points` distinct keyframe pixels; ages 0 .. frames - 1.
+class MeasurementCurve {
+ public:
+  MeasurementCurve(int frames, int min_plane_points) : frames_(frames), min_plane_points_(min_plane_points) {}
+  // A point of plane `plane` (made at frame `keyframe`) searched for in frame `frame`; `used`: the update used it.
+  void Add(int frame, int keyframe, int plane, const Eigen::Vector2d& keyframe_pixel, bool used);
+  std::vector<double> Mean() const;
+
+ private:
+  struct Counts {
+    std::vector<int> used;                  // by age; empty until first used within `frames_`
+    std::set<std::pair<int, int>> members;  // distinct keyframe pixels
+  };
+  int frames_, min_plane_points_;
+  std::map<std::pair<int, int>, Counts> planes_;  // by (keyframe, plane id)
+};
+
 // True, with its world position, if point `id` of the filter is known to kMappedRelativeSigma.
 bool PointInWorld(const Filter& filter, int id, Eigen::Vector3d* point_in_world);
 // Plane `id` of the filter with track `track` as a polygon in the world; false if it has fewer than
 // `min_points` points or one of its hull's rays does not meet it in front.
 bool PlaneInWorld(const Filter& filter, int id, const PlaneTrack& track, int min_points, MapPlane* plane);
-// The area (keyframe px^2) of the convex hull of a plane's points' keyframe pixels.
+// The convex hull of a plane's points' keyframe pixels, in order around it, and its area (keyframe px^2).
+std::vector<Eigen::Vector2d> PlaneHull(const PlaneTrack& track);
 double PlaneArea(const PlaneTrack& track);
 
 // The record of a run: what left the filters, and every plane that reached min_plane_points. Each start of the
@@ -86,5 +106,8 @@ Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points)
 // ASCII PLY: vertices (x y z and an RGB colour: points grey, plane corners coloured by their normal, camera
 // positions red), one face per plane polygon, and one edge per step of the camera path. Written atomically.
 void WritePly(const std::string& path, const Map& map, const Trajectory& camera_path);
+// Reads a file that WritePly wrote: the map (plane normals from their colour, to about half a degree) and the
+// camera path's positions. Throws IoError or FormatError naming the file.
+Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path);
 
 }  // namespace pdvo::vo

@@ -153,6 +153,14 @@ class Odometry {
   Map map() const;
   // The features searched for in the last frame.
   const std::vector<Observation>& observations() const;
+  // The planes in the filter as seen from the last frame's pose (pixels): the region their points span (the
+  // convex hull of their keyframe pixels, carried through the plane) and, for detected planes, the detected
+  // polygon likewise. Vertices behind either camera are left out.
+  struct PlaneOutline {
+    int id = -1;
+    std::vector<Eigen::Vector2d> region, detected;
+  };
+  std::vector<PlaneOutline> plane_outlines() const;
   // Mode pdvo: keyframes not detected (a newer one replaced them while the detector was busy), detections
   // given up (deterministic timeout), and detections whose detector threw.
   struct DetectionCounts {

@@ -103,6 +103,7 @@ struct PlaneTrack {
   // corners within grow_radius of its members, by the options' new_plane_points.
   bool detected = false;
   std::vector<int> region_corners;
+  std::vector<Eigen::Vector2d> outline;  // a detected plane's polygon, keyframe pixels
   int new_points = 0;
 };
 
