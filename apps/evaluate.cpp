@@ -20,7 +20,7 @@ int RunEvaluate(int argc, char** argv) {
   std::vector<std::string> inputs, overrides;
   std::string model_path, json_path, config_path, verbosity = "info";
   uint64_t seed = 1;
-  bool per_image = false;
+  bool per_image = false, no_fusion = false;
   app.add_option("--model,-m", model_path, "Model file (from pdvo train)")->required();
   app.add_option("--annotations,-a", inputs, "Folders (or files) of annotations")->required();
   app.add_option("--json", json_path,
@@ -30,12 +30,17 @@ int RunEvaluate(int argc, char** argv) {
                  "windows_per_shape=4");
   app.add_option("--seed", seed, "Seed for the sub-windows")->capture_default_str();
   app.add_flag("--per-image", per_image, "Print a row per image");
+  app.add_flag("--no-fusion", no_fusion,
+               "Normals from the regressors alone, not fused with the edges' vanishing direction (as if the model's "
+               "recogniser.vanishing.fuse_normals were false)");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
   const RegionSamplingOptions sampling = LoadToolOptions<RegionSamplingOptions>(config_path, "regions", overrides);
-  const Recogniser recogniser(PlaneModel::Read(model_path));
+  PlaneModel model = PlaneModel::Read(model_path);
+  if (no_fusion) model.options.vanishing.fuse_normals = false;
+  const Recogniser recogniser(std::move(model));
   const std::vector<std::string> files = ListAnnotationFiles(inputs);
   const std::vector<ImageEvaluation> rows = EvaluateRecogniser(recogniser, files, sampling, seed);
   const RecognitionMetrics m = ComputeRecognitionMetrics(AllSamples(rows));

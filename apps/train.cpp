@@ -14,17 +14,22 @@ int RunTrain(int argc, char** argv) {
   CLI::App app(
       "Trains the plane recogniser on annotated images (LabelMe JSON with a normal per plane, images "
       "beside them; e.g. from pdvo synth or pdvo annotate-depth): regions from the annotations, two "
-      "visual vocabularies, topics, spatiograms, a committee of RVM classifiers and RVM normal regressors. "
+      "visual vocabularies, topics, spatiograms, a committee of classifiers and normal regressors (RVMs, or "
+      "OpenCV ml's SVMs, kNN or random trees: --classifier). "
       "Writes one model file (YAML) holding everything inference needs and a training card.",
       "pdvo train");
   std::vector<std::string> inputs, overrides;
-  std::string out_path, config_path, verbosity = "info";
+  std::string out_path, config_path, verbosity = "info", classifier;
   uint64_t seed = 1;
   int folds = 3;
   app.add_option("--annotations,-a", inputs, "Folders (or files) of annotations; give several")->required();
   app.add_option("--out,-o", out_path, "Model file to write (YAML)")->required();
   AddConfigFlags(app, &config_path, &overrides, "Training options (YAML, section 'train'; see models/README.md)",
                  "rvm.gammas=0.1,0.5");
+  app.add_option("--classifier", classifier,
+                 "Learner of the classifiers and normal regressors: rvm, svm, knn or trees (default: the options' "
+                 "classifier, rvm)")
+      ->check(CLI::IsMember({"rvm", "svm", "knn", "trees"}));
   app.add_option("--seed", seed, "Seed for sampling, k-means, topics and folds")->capture_default_str();
   app.add_option("--cv", folds, "Cross-validation folds (grouped by image) to choose kernel widths; 1: none")
       ->capture_default_str()
@@ -33,6 +38,7 @@ int RunTrain(int argc, char** argv) {
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
 
+  if (!classifier.empty()) overrides.push_back("classifier=" + classifier);
   const TrainOptions options = LoadToolOptions<TrainOptions>(config_path, "train", overrides);
   const std::vector<std::string> files = ListAnnotationFiles(inputs);
   std::ostringstream data;
@@ -51,15 +57,21 @@ int RunTrain(int argc, char** argv) {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   std::string classifier_sizes;
-  for (const RvmFunction& f : model.classifiers) {
-    classifier_sizes += (classifier_sizes.empty() ? "" : "/") + std::to_string(f.size());
+  for (const Learned& f : model.classifiers) {
+    if (!classifier_sizes.empty()) classifier_sizes += '/';
+    classifier_sizes += std::to_string(f.size);
   }
+  const char* const sizes = options.classifier == LearnerKind::kRvm   ? "relevance vectors"
+                            : options.classifier == LearnerKind::kSvm ? "support vectors"
+                            : options.classifier == LearnerKind::kKnn ? "samples"
+                                                                      : "tree nodes";
   std::printf(
       "wrote %s: %d images, %d+%d regions per classifier, cv accuracy %.3f, cv normal error %.1f deg, "
-      "relevance vectors %s (%zu classifiers) %d/%d/%d (normal); peak memory %.0f MiB\n",
+      "%s %s (%zu %s classifiers) %d/%d/%d (normal); peak memory %.0f MiB\n",
       out_path.c_str(), model.card.images, model.card.plane_regions, model.card.non_plane_regions,
-      model.card.cv_accuracy, model.card.cv_normal_error, classifier_sizes.c_str(), model.classifiers.size(),
-      model.normal[0].size(), model.normal[1].size(), model.normal[2].size(), usage.ru_maxrss / 1024.0);
+      model.card.cv_accuracy, model.card.cv_normal_error, sizes, classifier_sizes.c_str(), model.classifiers.size(),
+      OptionName(options.classifier).c_str(), model.normal[0].size, model.normal[1].size, model.normal[2].size,
+      usage.ru_maxrss / 1024.0);
   return 0;
 }
 

@@ -59,7 +59,108 @@ RvmFunction ReadRvm(const cv::FileNode& node, const std::string& where, int dims
   return f;
 }
 
+cv::Mat ToFloatRows(const Eigen::MatrixXd& rows) { return ToFloatMat(rows); }
+
+// A member of `classifiers` or a normal regressor. RVM: as version 3 wrote it; the others: their kind, their
+// size, Platt's parameters (SVM classifier) and the OpenCV model as it writes itself.
+void WriteLearned(cv::FileStorage& fs, const std::string& name, const Learned& f) {
+  if (f.kind == LearnerKind::kRvm) return WriteRvm(fs, name, f.rvm);
+  if (!name.empty()) fs << name;
+  fs << "{"
+     << "kind" << OptionName(f.kind) << "size" << f.size;
+  if (f.kind == LearnerKind::kSvm && f.classifier) fs << "platt_a" << f.platt_a << "platt_b" << f.platt_b;
+  fs << "model"
+     << "{";
+  f.ml->write(fs);
+  fs << "}"
+     << "}";
+}
+
+Learned ReadLearned(const cv::FileNode& node, const std::string& where, int dims, LearnerKind kind, bool classifier) {
+  if (kind == LearnerKind::kRvm) return Learned::Rvm(ReadRvm(node, where, dims), classifier);
+  PDVO_THROW_CHECK(node.isMap(), FormatError, where << ": missing");
+  PDVO_THROW_CHECK(
+      static_cast<std::string>(node["kind"]) == OptionName(kind), FormatError,
+      where << ": a " << static_cast<std::string>(node["kind"]) << " model in a " << OptionName(kind) << " file");
+  Learned f;
+  f.kind = kind;
+  f.classifier = classifier;
+  f.size = static_cast<int>(node["size"]);
+  if (kind == LearnerKind::kSvm && classifier) {
+    f.platt_a = static_cast<double>(node["platt_a"]);
+    f.platt_b = static_cast<double>(node["platt_b"]);
+  }
+  const cv::FileNode model = node["model"];
+  PDVO_THROW_CHECK(model.isMap(), FormatError, where << ": no model");
+  try {
+    if (kind == LearnerKind::kSvm) f.ml = cv::ml::SVM::create();
+    if (kind == LearnerKind::kKnn) f.ml = cv::ml::KNearest::create();
+    if (kind == LearnerKind::kTrees) f.ml = cv::ml::RTrees::create();
+    f.ml->read(model);
+  } catch (const cv::Exception& e) {
+    PDVO_THROW(FormatError, where << ": malformed " << OptionName(kind) << " model");
+  }
+  PDVO_THROW_CHECK(f.ml->isTrained() && f.ml->getVarCount() == dims && f.size >= 0 && std::isfinite(f.platt_a) &&
+                       std::isfinite(f.platt_b),
+                   FormatError, where << ": malformed " << OptionName(kind) << " model (sizes do not agree)");
+  return f;
+}
+
 }  // namespace
+
+Learned Learned::Rvm(RvmFunction f, bool classifier) {
+  Learned l;
+  l.kind = LearnerKind::kRvm;
+  l.classifier = classifier;
+  l.size = f.size();
+  l.rvm = std::move(f);
+  return l;
+}
+
+Eigen::VectorXd Learned::Evaluate(const Eigen::MatrixXd& rows) const {
+  if (kind == LearnerKind::kRvm) {
+    const Eigen::VectorXd v = rvm.Evaluate(rows);
+    return classifier ? Eigen::VectorXd((1.0 + (-v).array().exp()).inverse().matrix()) : v;
+  }
+  Eigen::VectorXd out(rows.rows());
+  if (rows.rows() == 0) return out;
+  const cv::Mat x = ToFloatRows(rows);
+  cv::Mat values;
+  if (kind == LearnerKind::kSvm) {
+    ml->predict(x, values, classifier ? cv::ml::StatModel::RAW_OUTPUT : 0);
+    for (int i = 0; i < x.rows; ++i) {
+      const double f = values.at<float>(i);
+      out[i] = classifier ? 1.0 / (1.0 + std::exp(platt_a * f + platt_b)) : f;
+    }
+  } else if (kind == LearnerKind::kKnn) {
+    const auto knn = ml.dynamicCast<cv::ml::KNearest>();
+    const int k = knn->getDefaultK();
+    cv::Mat neighbours;
+    knn->findNearest(x, k, values, neighbours);
+    for (int i = 0; i < x.rows; ++i) {
+      out[i] = classifier ? (cv::sum(neighbours.row(i))[0] + 1.0) / (k + 2.0) : values.at<float>(i);
+    }
+  } else if (classifier) {  // trees: the share of votes for the plane class (label 1)
+    cv::Mat votes;
+    ml.dynamicCast<cv::ml::RTrees>()->getVotes(x, votes, 0);
+    int plane = -1;
+    for (int c = 0; c < votes.cols; ++c) plane = votes.at<int>(0, c) == 1 ? c : plane;
+    for (int i = 0; i < x.rows; ++i) {
+      const double all = cv::sum(votes.row(i + 1))[0];
+      out[i] = plane < 0 || all <= 0 ? 0.0 : votes.at<int>(i + 1, plane) / all;
+    }
+  } else {
+    ml->predict(x, values);
+    for (int i = 0; i < x.rows; ++i) out[i] = values.at<float>(i);
+  }
+  return out;
+}
+
+double Learned::operator()(const Eigen::VectorXd& x) const {
+  if (kind != LearnerKind::kRvm) return Evaluate(x.transpose())[0];
+  const double v = rvm(x);
+  return classifier ? 1.0 / (1.0 + std::exp(-v)) : v;
+}
 
 double RvmFunction::operator()(const Eigen::VectorXd& x) const {
   double sum = -bias;
@@ -90,7 +191,7 @@ bool RecogniserOptions::Check() const {
 std::string PlaneModel::ToYaml() const {
   // Matrices in base64 (raw bytes: a third of the size of their text, and exactly the same values).
   cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::BASE64);
-  fs << "format" << kModelFormat << "version" << kModelVersion;
+  fs << "format" << kModelFormat << "version" << kModelVersion << "learner" << OptionName(learner());
   fs << "options"
      << "{";
   WriteOptions(fs, options);
@@ -106,11 +207,11 @@ std::string PlaneModel::ToYaml() const {
   fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale" << ToMat(feature_scale);
   fs << "classifiers"
      << "[";
-  for (const RvmFunction& f : classifiers) WriteRvm(fs, "", f);
+  for (const Learned& f : classifiers) WriteLearned(fs, "", f);
   fs << "]";
-  WriteRvm(fs, "normal_x", normal[0]);
-  WriteRvm(fs, "normal_y", normal[1]);
-  WriteRvm(fs, "normal_z", normal[2]);
+  WriteLearned(fs, "normal_x", normal[0]);
+  WriteLearned(fs, "normal_y", normal[1]);
+  WriteLearned(fs, "normal_z", normal[2]);
   fs << kEndMarker << kModelFormat;
   return fs.releaseAndGetString();
 }
@@ -126,9 +227,18 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
   PDVO_THROW_CHECK(static_cast<std::string>(fs["format"]) == kModelFormat, FormatError,
                    where << ": not a " << kModelFormat << " file");
   const int version = static_cast<int>(fs["version"]);
-  PDVO_THROW_CHECK(version == kModelVersion, FormatError,
-                   where << ": model version " << version << ", this build reads version " << kModelVersion
+  PDVO_THROW_CHECK(version == kModelVersion || version == 3, FormatError,
+                   where << ": model version " << version << ", this build reads versions 3 and " << kModelVersion
                          << " (retrain with pdvo train)");
+  LearnerKind learner = LearnerKind::kRvm;  // version 3: RVMs
+  if (version >= 4) {
+    const std::string name = static_cast<std::string>(fs["learner"]);
+    bool known = false;
+    for (const auto& [kind, kind_name] : OptionNames(LearnerKind{})) {
+      if (name == kind_name) learner = kind, known = true;
+    }
+    PDVO_THROW_CHECK(known, FormatError, where << ": unknown learner '" << name << "'");
+  }
   PDVO_THROW_CHECK(static_cast<std::string>(fs[kEndMarker]) == kModelFormat, FormatError,
                    where << ": truncated model (no end marker)");
   PlaneModel m;
@@ -165,11 +275,11 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
   PDVO_THROW_CHECK(classifiers.isSeq() && classifiers.size() > 0, FormatError, where << ": no classifiers");
   for (size_t i = 0; i < classifiers.size(); ++i) {
     const std::string what = where + ": classifier " + std::to_string(i);
-    m.classifiers.push_back(ReadRvm(classifiers[static_cast<int>(i)], what, dims));
+    m.classifiers.push_back(ReadLearned(classifiers[static_cast<int>(i)], what, dims, learner, true));
   }
-  m.normal[0] = ReadRvm(fs["normal_x"], where + ": normal_x", dims);
-  m.normal[1] = ReadRvm(fs["normal_y"], where + ": normal_y", dims);
-  m.normal[2] = ReadRvm(fs["normal_z"], where + ": normal_z", dims);
+  m.normal[0] = ReadLearned(fs["normal_x"], where + ": normal_x", dims, learner, false);
+  m.normal[1] = ReadLearned(fs["normal_y"], where + ": normal_y", dims, learner, false);
+  m.normal[2] = ReadLearned(fs["normal_z"], where + ": normal_z", dims, learner, false);
   return m;
 }
 

@@ -140,9 +140,10 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
                    "recogniser: the topic basis does not match the vocabularies");
   const Eigen::Index dims = RegionFeatureDims(static_cast<int>(model_.topics.cols()));
   PDVO_THROW_CHECK(!model_.classifiers.empty(), InvalidArgument, "recogniser: the model has no classifier");
-  const bool classifiers_fit =
-      std::all_of(model_.classifiers.begin(), model_.classifiers.end(),
-                  [&](const RvmFunction& f) { return f.size() == 0 || f.vectors.cols() == dims; });
+  const bool classifiers_fit = std::all_of(model_.classifiers.begin(), model_.classifiers.end(), [&](const Learned& f) {
+    return f.kind == LearnerKind::kRvm ? f.rvm.size() == 0 || f.rvm.vectors.cols() == dims
+                                       : f.ml && f.ml->getVarCount() == dims;
+  });
   PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifiers_fit, InvalidArgument,
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
 }
@@ -157,12 +158,13 @@ ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera
 RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
   PDVO_THROW_CHECK(feature.size() == model_.feature_mean.size(), InvalidArgument,
                    "recogniser: a " << feature.size() << "-D feature for a model of " << model_.feature_mean.size());
+  if (model_.learner() != LearnerKind::kRvm) return PredictRows(feature.transpose()).front();
   const Eigen::VectorXd x = (feature - model_.feature_mean).cwiseQuotient(model_.feature_scale);
   RegionPrediction p;
   p.valid = true;
-  for (const RvmFunction& f : model_.classifiers) p.plane_probability += 1.0 / (1.0 + std::exp(-f(x)));
+  for (const Learned& f : model_.classifiers) p.plane_probability += 1.0 / (1.0 + std::exp(-f.rvm(x)));
   p.plane_probability /= static_cast<double>(model_.classifiers.size());
-  const Eigen::Vector3d n(model_.normal[0](x), model_.normal[1](x), model_.normal[2](x));
+  const Eigen::Vector3d n(model_.normal[0].rvm(x), model_.normal[1].rvm(x), model_.normal[2].rvm(x));
   if (n.norm() > 1e-9) p.normal = n.normalized();
   return p;
 }
@@ -173,9 +175,7 @@ std::vector<RegionPrediction> Recogniser::PredictRows(const Eigen::MatrixXd& fea
   const Eigen::MatrixXd x = (features.rowwise() - model_.feature_mean.transpose()).array().rowwise() /
                             model_.feature_scale.transpose().array();
   Eigen::VectorXd probability = Eigen::VectorXd::Zero(x.rows());
-  for (const RvmFunction& f : model_.classifiers) {
-    probability += (1.0 + (-f.Evaluate(x)).array().exp()).inverse().matrix();
-  }
+  for (const Learned& f : model_.classifiers) probability += f.Evaluate(x);
   probability /= static_cast<double>(model_.classifiers.size());
   const Eigen::VectorXd nx = model_.normal[0].Evaluate(x), ny = model_.normal[1].Evaluate(x);
   const Eigen::VectorXd nz = model_.normal[2].Evaluate(x);

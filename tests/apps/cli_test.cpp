@@ -13,6 +13,7 @@
 
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/common/file_io.h"
+#include "pdvo/common/options.h"
 #include "pdvo/common/trajectory.h"
 #include "pdvo/infer/model.h"
 #include "pdvo/test/annotations.h"
@@ -311,7 +312,7 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   const PlaneModel model = PlaneModel::Read(dir / "m.yml");
   ASSERT_EQ(model.classifiers.size(), 15u);
   for (size_t i = 1; i < model.classifiers.size(); ++i) {
-    const RvmFunction &a = model.classifiers[0], &b = model.classifiers[i];
+    const RvmFunction &a = model.classifiers[0].rvm, &b = model.classifiers[i].rvm;
     EXPECT_FALSE(a.size() == b.size() && a.vectors == b.vectors) << "classifiers 0 and " << i << " are the same";
   }
 
@@ -365,6 +366,29 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   EXPECT_EQ(unfused["accuracy"], overall["accuracy"]);
   EXPECT_LT(overall["normal_error_deg"]["mean"].get<double>(), unfused["normal_error_deg"]["mean"].get<double>())
       << e.out << u.out;
+  // evaluate --no-fusion is that edit.
+  const CommandResult nf = Pdvo("evaluate -m " + (dir / "m.yml") + " -a " + (dir / "test/annotations") +
+                                    " --no-fusion --json " + (dir / "nofusion.json") + " -v warning",
+                                dir);
+  ASSERT_EQ(nf.code, 0) << nf.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(dir / "nofusion.json"))["overall"], unfused);
+
+  // The other learners in the RVM's place, on the same street: each beats chance by a wide margin and names
+  // itself in the file.
+  for (const char* learner : {"svm", "knn", "trees"}) {
+    SCOPED_TRACE(learner);
+    const std::string model = dir / (std::string(learner) + ".yml"), json = dir / (std::string(learner) + ".json");
+    const CommandResult lt =
+        Pdvo("train -a " + (dir / "train/annotations") + " -o " + model + " --classifier " + learner + small, dir);
+    ASSERT_EQ(lt.code, 0) << lt.err;
+    EXPECT_EQ(OptionName(PlaneModel::Read(model).learner()), learner);
+    const CommandResult le =
+        Pdvo("evaluate -m " + model + " -a " + (dir / "test/annotations") + " --json " + json + " -v warning", dir);
+    ASSERT_EQ(le.code, 0) << le.err;
+    const nlohmann::json o = nlohmann::json::parse(ReadFile(json))["overall"];
+    EXPECT_GT(o["balanced_accuracy"].get<double>(), 0.8) << le.out;
+    EXPECT_LT(o["normal_error_deg"]["mean"].get<double>(), 35) << le.out;
+  }
 }
 
 TEST(Cli, TrainAndEvaluateRejectBadInputs) {
@@ -384,6 +408,10 @@ TEST(Cli, TrainAndEvaluateRejectBadInputs) {
                "no non-plane regions");
   expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifiers=0",
                "invalid train options: classifiers >= 1 does not hold (classifiers = 0)");
+  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --classifier forest",
+               "--classifier: forest not in {rvm,svm,knn,trees}");
+  expect_error("train -a " + (dir / "planes") + " -o " + (dir / "m.yml") + " --set classifier=forest",
+               "'forest' is not one of rvm, svm, knn, trees");
   // A missing image.
   a.image_path = "gone.png";
   fs::create_directories(dir / "missing");

@@ -9,6 +9,7 @@
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/infer/recogniser.h"
+#include "pdvo/test/models.h"
 #include "pdvo/test/support.h"
 
 namespace pdvo {
@@ -27,19 +28,10 @@ RvmFunction RandomRvm(int vectors, int dims, std::mt19937& rng) {
 // A small model with random contents: 12 gradient words, 5 colour words, 3 topics.
 PlaneModel RandomModel() {
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(0, 1);
-  cv::Mat g(12, kGradientDims, CV_32F), c(5, kColourDims, CV_32F);
-  cv::randu(g, 0, 100);
-  cv::randu(c, 0, 1);
-  PlaneModel m;
-  m.gradient_words = Vocabulary(g);
-  m.colour_words = Vocabulary(c);
-  m.topics = Eigen::MatrixXd::NullaryExpr(17, 3, [&]() { return u(rng); });
+  PlaneModel m = test::RandomModelWithoutLearners(rng);
   const int dims = RegionFeatureDims(3);
-  m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
-  m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
-  for (int size : {4, 2, 5}) m.classifiers.push_back(RandomRvm(size, dims, rng));
-  for (RvmFunction& f : m.normal) f = RandomRvm(3, dims, rng);
+  for (int size : {4, 2, 5}) m.classifiers.push_back(Learned::Rvm(RandomRvm(size, dims, rng), true));
+  for (Learned& f : m.normal) f = Learned::Rvm(RandomRvm(3, dims, rng), false);
   m.card.data = "synthetic streets";
   m.card.images = 7;
   m.card.cv_accuracy = 0.93;
@@ -73,7 +65,7 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   // are what they are.
   ASSERT_EQ(back.classifiers.size(), m.classifiers.size());
   for (size_t i = 0; i < m.classifiers.size(); ++i) {
-    const RvmFunction &f = m.classifiers[i], &read = back.classifiers[i];
+    const RvmFunction &f = m.classifiers[i].rvm, &read = back.classifiers[i].rvm;
     EXPECT_EQ(read.vectors, f.vectors.cast<float>().cast<double>());
     EXPECT_NEAR(read(x), f(x), 1e-5 * (1 + std::abs(f(x))));
   }
@@ -93,12 +85,12 @@ TEST(Model, PlaneProbabilityIsTheClassifiersMeanProbability) {
   const Eigen::VectorXd x = Eigen::VectorXd::NullaryExpr(m.feature_mean.size(), [&]() { return g(rng); });
   const Eigen::VectorXd standardised = (x - m.feature_mean).cwiseQuotient(m.feature_scale);
   double mean = 0;
-  for (const RvmFunction& f : m.classifiers) mean += 1 / (1 + std::exp(-f(standardised))) / 3;
+  for (const Learned& f : m.classifiers) mean += 1 / (1 + std::exp(-f.rvm(standardised))) / 3;
   EXPECT_NEAR(Recogniser(m).Predict(x).plane_probability, mean, 1e-12);
   // One member alone gives its own probability, which differs from the committee's.
   PlaneModel one = m;
   one.classifiers.resize(1);
-  const double alone = 1 / (1 + std::exp(-m.classifiers[0](standardised)));
+  const double alone = 1 / (1 + std::exp(-m.classifiers[0].rvm(standardised)));
   EXPECT_NEAR(Recogniser(one).Predict(x).plane_probability, alone, 1e-12);
   EXPECT_GT(std::abs(alone - mean), 1e-3);
   one.classifiers.clear();
@@ -118,7 +110,8 @@ TEST(Model, RecognisedNormalsFaceTheCamera) {
   // Regressors that say n = (0.6, 0, 0.8) everywhere: a plane facing away from a camera looking along +z.
   PlaneModel m = RandomModel();
   const int dims = static_cast<int>(m.feature_mean.size());
-  m.normal = {Constant(0.6, dims), Constant(0, dims), Constant(0.8, dims)};
+  m.normal = {Learned::Rvm(Constant(0.6, dims), false), Learned::Rvm(Constant(0, dims), false),
+              Learned::Rvm(Constant(0.8, dims), false)};
   cv::Mat image(240, 320, CV_8UC3);
   cv::theRNG().state = 5;
   cv::randu(image, 0, 255);  // noise: many salient points, no straight edges, no vertical
@@ -171,9 +164,17 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   const std::string version = "version: " + std::to_string(kModelVersion);
   ASSERT_NE(other.find(version), std::string::npos);
   other.replace(other.find(version), version.size(), "version: 7");
-  EXPECT_NE(message_of(other).find("model version 7, this build reads version " + std::to_string(kModelVersion)),
+  EXPECT_NE(message_of(other).find("model version 7, this build reads versions 3 and " + std::to_string(kModelVersion)),
             std::string::npos)
       << message_of(other);
+  // Version 3 (RVMs, no learner named) is read; an unknown learner is refused.
+  std::string three = text;
+  three.replace(three.find(version), version.size(), "version: 3");
+  three.replace(three.find("learner: rvm\n"), 13, "");
+  EXPECT_EQ(PlaneModel::FromYaml(three, "m.yml").ToYaml(), text);
+  std::string unknown = text;
+  unknown.replace(unknown.find("learner: rvm"), 12, "learner: svr");
+  EXPECT_NE(message_of(unknown).find("m.yml: unknown learner 'svr'"), std::string::npos) << message_of(unknown);
   // Cut at a line boundary (valid YAML, no end marker) and in the middle of a matrix.
   const std::string at_line = text.substr(0, text.rfind('\n', text.size() / 2) + 1);
   EXPECT_NE(message_of(at_line).find("m.yml"), std::string::npos);

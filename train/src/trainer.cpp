@@ -12,8 +12,7 @@
 #include "pdvo/common/options.h"
 #include "pdvo/eval/recognition.h"
 #include "pdvo/infer/recogniser.h"
-#include "pdvo/train/sparse_bayes.h"
-#include "rvm.h"
+#include "pdvo/train/learners.h"
 
 namespace pdvo {
 namespace {
@@ -69,19 +68,18 @@ std::vector<T> Pick(const std::vector<T>& v, const std::vector<int>& rows) {
   return out;
 }
 
-Eigen::Vector3d PredictNormal(const std::array<RvmFunction, 3>& f, const Eigen::VectorXd& x) {
+Eigen::Vector3d PredictNormal(const std::array<Learned, 3>& f, const Eigen::VectorXd& x) {
   const Eigen::Vector3d n(f[0](x), f[1](x), f[2](x));
   return n.norm() > 1e-9 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d(0, 0, -1);
 }
 
-std::array<RvmFunction, 3> TrainNormal(const Eigen::MatrixXd& x, const std::vector<Eigen::Vector3d>& normals,
-                                       double gamma, const RvmOptions& o) {
-  std::array<RvmFunction, 3> f;
+std::array<Learned, 3> TrainNormal(const TrainOptions& o, const internal::LearnerSetting& setting,
+                                   const Eigen::MatrixXd& x, const std::vector<Eigen::Vector3d>& normals) {
+  std::array<Learned, 3> f;
   for (int c = 0; c < 3; ++c) {
     std::vector<double> t;
     for (const auto& n : normals) t.push_back(n[c]);
-    f[c] = TrainSparseBayesRegression(x, Eigen::Map<const Eigen::VectorXd>(t.data(), x.rows()),
-                                      {gamma, o.max_iterations, 1e-6});
+    f[c] = internal::TrainRegressor(o, setting, x, Eigen::Map<const Eigen::VectorXd>(t.data(), x.rows()));
   }
   return f;
 }
@@ -96,20 +94,21 @@ void Split(const std::vector<int>& image_of_row, const std::vector<int>& fold_of
   }
 }
 
-struct WidthChoice {
-  double gamma = 0;
+struct SettingChoice {
+  internal::LearnerSetting setting;
   double loss = -1;  // mean cross-validated loss per test row; -1 without cross-validation
 };
 
-// The kernel width among `gammas` with the lowest mean loss over the folds (grouped by image). `fold_loss(train,
-// test, gamma)` trains on the rows `train` and returns the summed loss over the rows `test`, or nothing to skip
-// the fold. With fewer than 2 folds (or no rows), the first width.
+// The setting (kernel width, ...) among `settings` with the lowest mean loss over the folds (grouped by image).
+// `fold_loss(train, test, setting)` trains on the rows `train` and returns the summed loss over the rows `test`,
+// or nothing to skip the fold. With fewer than 2 folds (or no rows), the first setting.
 template <class FoldLoss>
-WidthChoice ChooseWidth(const std::vector<double>& gammas, int folds, const std::vector<int>& image_of_row,
-                        const std::vector<int>& fold_of_image, const char* what, FoldLoss fold_loss) {
-  WidthChoice best{gammas.front(), -1};
+SettingChoice ChooseSetting(const std::vector<internal::LearnerSetting>& settings, double dims, int folds,
+                            const std::vector<int>& image_of_row, const std::vector<int>& fold_of_image,
+                            const char* what, FoldLoss fold_loss) {
+  SettingChoice best{settings.front(), -1};
   if (folds < 2 || image_of_row.empty()) return best;
-  for (double g : gammas) {
+  for (const internal::LearnerSetting& g : settings) {
     double sum = 0;
     size_t tested = 0;
     std::vector<int> train, test;
@@ -123,7 +122,7 @@ WidthChoice ChooseWidth(const std::vector<double>& gammas, int folds, const std:
     }
     if (tested == 0) continue;
     const double mean = sum / tested;
-    PDVO_LOG(Info) << "cross-validation: gamma " << g << "/D, " << what << " " << mean;
+    PDVO_LOG(Info) << "cross-validation: " << g.Describe(dims) << ", " << what << " " << mean;
     if (best.loss < 0 || mean < best.loss) best = {g, mean};
   }
   return best;
@@ -138,8 +137,29 @@ bool RvmOptions::Check() const {
   return true;
 }
 
+bool SvmOptions::Check() const {
+  PDVO_CHECK_OPTION(!gammas.empty() && !c.empty() && epsilon >= 0);
+  PDVO_CHECK_OPTION(std::all_of(gammas.begin(), gammas.end(), [](double g) { return g > 0; }));
+  PDVO_CHECK_OPTION(std::all_of(c.begin(), c.end(), [](double v) { return v > 0; }));
+  return true;
+}
+
+bool KnnOptions::Check() const {
+  PDVO_CHECK_OPTION(!k.empty());
+  PDVO_CHECK_OPTION(std::all_of(k.begin(), k.end(), [](double v) { return v >= 1 && v == std::floor(v); }));
+  return true;
+}
+
+bool TreesOptions::Check() const {
+  PDVO_CHECK_OPTION(trees >= 1 && min_samples >= 1 && !max_depth.empty());
+  PDVO_CHECK_OPTION(
+      std::all_of(max_depth.begin(), max_depth.end(), [](double v) { return v >= 1 && v == std::floor(v); }));
+  return true;
+}
+
 bool TrainOptions::Check() const {
-  PDVO_CHECK_OPTION(recogniser.Check() && regions.Check() && topics.Check() && rvm.Check());
+  PDVO_CHECK_OPTION(recogniser.Check() && regions.Check() && topics.Check() && rvm.Check() && svm.Check() &&
+                    knn.Check() && trees.Check());
   PDVO_CHECK_OPTION(gradient_words >= 2 && colour_words >= 2);
   PDVO_CHECK_OPTION(vocabulary_samples >= std::max(gradient_words, colour_words));
   PDVO_CHECK_OPTION(kmeans_iterations >= 1);
@@ -267,10 +287,13 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   };
   PDVO_LOG(Info) << "[time] " << used.size() << " region features (" << dims << "-D) in " << Since(stage) << " s";
 
-  // 6. RVMs, with kernel widths chosen by cross-validation grouped by image.
+  // 6. Classifiers and normal regressors, with their settings chosen by cross-validation grouped by image.
   const std::vector<int> fold_of_image = FoldOfImage(static_cast<int>(files.size()), folds, rng);
-  const RvmOptions& rvm = o.rvm;
-  auto gamma_of = [&](double g) { return g / static_cast<double>(dims); };
+  const std::vector<internal::LearnerSetting> settings = internal::Settings(o, static_cast<double>(dims));
+  const char* const vectors = o.classifier == LearnerKind::kRvm   ? "relevance vectors"
+                              : o.classifier == LearnerKind::kSvm ? "support vectors"
+                              : o.classifier == LearnerKind::kKnn ? "samples"
+                                                                  : "tree nodes";
 
   stage = Clock::now();
   auto labels_of = [&](const std::vector<int>& rows) {
@@ -283,31 +306,30 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   std::vector<int> image_c;
   for (int k : draws.front()) image_c.push_back(regions[k].image);
   // Loss: the share of misclassified test rows.
-  const WidthChoice classifier_width =
-      ChooseWidth(rvm.gammas, folds, image_c, fold_of_image, "classifier error",
-                  [&](const auto& train, const auto& test, double g) {
-                    const std::vector<double> train_labels = Pick(labels, train);
-                    std::optional<double> errors;
-                    if (std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
-                        std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
-                      return errors;  // a fold without both classes says nothing
-                    }
-                    const RvmFunction fn = internal::TrainRvmClassifier(Rows(xc, train), train_labels, gamma_of(g),
-                                                                        rvm.epsilon, rvm.max_iterations);
-                    errors = 0.0;
-                    for (int r : test) *errors += (fn(xc.row(r).transpose()) >= 0) != (labels[r] > 0);
-                    return errors;
-                  });
-  const double best_gamma = classifier_width.gamma;
+  const SettingChoice classifier_choice =
+      ChooseSetting(settings, static_cast<double>(dims), folds, image_c, fold_of_image, "classifier error",
+                    [&](const auto& train, const auto& test, const internal::LearnerSetting& g) {
+                      const std::vector<double> train_labels = Pick(labels, train);
+                      std::optional<double> errors;
+                      if (std::count(train_labels.begin(), train_labels.end(), 1.0) == 0 ||
+                          std::count(train_labels.begin(), train_labels.end(), -1.0) == 0) {
+                        return errors;  // a fold without both classes says nothing
+                      }
+                      const Learned fn = internal::TrainClassifier(o, g, Rows(xc, train), train_labels);
+                      errors = 0.0;
+                      for (int r : test) *errors += (fn(xc.row(r).transpose()) >= 0.5) != (labels[r] > 0);
+                      return errors;
+                    });
+  const internal::LearnerSetting& best = classifier_choice.setting;
   PlaneModel model;
   std::ostringstream sizes;
   for (const std::vector<int>& draw : draws) {
-    model.classifiers.push_back(internal::TrainRvmClassifier(matrix_of(draw), labels_of(draw), gamma_of(best_gamma),
-                                                             rvm.epsilon, rvm.max_iterations));
-    sizes << (sizes.tellp() > 0 ? "/" : "") << model.classifiers.back().size();
+    model.classifiers.push_back(internal::TrainClassifier(o, best, matrix_of(draw), labels_of(draw)));
+    sizes << (sizes.tellp() > 0 ? "/" : "") << model.classifiers.back().size;
   }
-  PDVO_LOG(Info) << "[time] " << draws.size() << " classifiers (gamma " << best_gamma << "/D, " << sizes.str()
-                 << " relevance vectors) in " << Since(stage) << " s";
+  PDVO_LOG(Info) << "[time] " << draws.size() << " " << OptionName(o.classifier) << " classifiers ("
+                 << best.Describe(static_cast<double>(dims)) << ", " << sizes.str() << " " << vectors << ") in "
+                 << Since(stage) << " s";
 
   stage = Clock::now();
   const Eigen::MatrixXd xn = matrix_of(normals);
@@ -318,24 +340,30 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
     image_n.push_back(regions[k].image);
   }
   // Loss: the angle between the true and the predicted normal, in degrees.
-  const WidthChoice normal_width =
-      ChooseWidth(rvm.gammas, folds, image_n, fold_of_image, "normal error (deg)",
-                  [&](const auto& train, const auto& test, double g) {
-                    const auto fn = TrainNormal(Rows(xn, train), Pick(targets, train), gamma_of(g), rvm);
-                    std::optional<double> sum = 0.0;
-                    for (int r : test) *sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose()));
-                    return sum;
-                  });
-  const double best_normal_gamma = normal_width.gamma;
+  const SettingChoice normal_choice =
+      ChooseSetting(settings, static_cast<double>(dims), folds, image_n, fold_of_image, "normal error (deg)",
+                    [&](const auto& train, const auto& test, const internal::LearnerSetting& g) {
+                      const auto fn = TrainNormal(o, g, Rows(xn, train), Pick(targets, train));
+                      std::optional<double> sum = 0.0;
+                      for (int r : test) *sum += AngleDegrees(targets[r], PredictNormal(fn, xn.row(r).transpose()));
+                      return sum;
+                    });
+  const internal::LearnerSetting& best_normal = normal_choice.setting;
   if (!normals.empty()) {
-    model.normal = TrainNormal(xn, targets, gamma_of(best_normal_gamma), rvm);
+    model.normal = TrainNormal(o, best_normal, xn, targets);
   } else {
+    PDVO_THROW_CHECK(
+        o.classifier == LearnerKind::kRvm, InvalidArgument,
+        "train: no plane regions with normals, which the " << OptionName(o.classifier) << " regressors need");
     PDVO_LOG(Warning) << "no plane regions with normals: the model predicts no orientation";
-    for (RvmFunction& f : model.normal) f.gamma = gamma_of(best_normal_gamma);
+    for (Learned& f : model.normal) {
+      f = Learned::Rvm(RvmFunction(), false);
+      f.rvm.gamma = best_normal.gamma;
+    }
   }
-  PDVO_LOG(Info) << "[time] normal regressors (gamma " << best_normal_gamma << "/D, " << model.normal[0].size() << "+"
-                 << model.normal[1].size() << "+" << model.normal[2].size() << " relevance vectors) in " << Since(stage)
-                 << " s";
+  PDVO_LOG(Info) << "[time] normal regressors (" << best_normal.Describe(static_cast<double>(dims)) << ", "
+                 << model.normal[0].size << "+" << model.normal[1].size << "+" << model.normal[2].size << " " << vectors
+                 << ") in " << Since(stage) << " s";
 
   model.options = o.recogniser;
   model.gradient_words = gradient_words;
@@ -349,8 +377,8 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   model.card.non_plane_regions = static_cast<int>(per_class);
   model.card.normal_regions = static_cast<int>(normals.size());
   model.card.folds = folds;
-  model.card.cv_accuracy = classifier_width.loss < 0 ? 0 : 1 - classifier_width.loss;
-  model.card.cv_normal_error = std::max(0.0, normal_width.loss);
+  model.card.cv_accuracy = classifier_choice.loss < 0 ? 0 : 1 - classifier_choice.loss;
+  model.card.cv_normal_error = std::max(0.0, normal_choice.loss);
   model.card.seed = static_cast<int>(seed);
   PDVO_LOG(Info) << "[time] trained in " << Since(start) << " s";
   return model;

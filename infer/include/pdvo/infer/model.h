@@ -1,14 +1,15 @@
 // The plane recogniser's model: everything inference needs, in ONE versioned file (cv::FileStorage YAML):
 // the recogniser options (version 2 added their `vanishing` section and two layout values), the two
-// vocabularies, the topic basis, the feature standardisation, a committee of RVM classifiers (plane
-// probability; version 3, one classifier before) and three RVM regressors (normal components), and a training
-// card.
+// vocabularies, the topic basis, the feature standardisation, a committee of classifiers (plane probability;
+// version 3, one classifier before) and three regressors (normal components), and a training card. Version 4
+// names the learner (`learner`: RVM, or OpenCV ml's SVM, kNN or random trees); version 3 files (RVM) are read.
 // Writing is atomic; re-writing a read model gives the same bytes. Relevance vectors are stored in single
 // precision (most of the file's bytes; predictions move by about 1e-7 relative), everything else in double.
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
+#include <opencv2/ml.hpp>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,7 @@
 namespace pdvo {
 
 inline constexpr const char* kModelFormat = "pdvo-plane-model";
-inline constexpr int kModelVersion = 3;
+inline constexpr int kModelVersion = 4;
 
 // A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
 struct RvmFunction {
@@ -32,6 +33,36 @@ struct RvmFunction {
   // The same for each row of `rows` at once (squared distances by one matrix product; equal to rounding).
   Eigen::VectorXd Evaluate(const Eigen::MatrixXd& rows) const;
   int size() const { return static_cast<int>(weights.size()); }
+};
+
+// The kinds of learner for the classifiers and the normal regressors (pdvo train --classifier).
+enum class LearnerKind { kRvm, kSvm, kKnn, kTrees };
+constexpr std::array<std::pair<LearnerKind, const char*>, 4> OptionNames(LearnerKind) {
+  return {{{LearnerKind::kRvm, "rvm"},
+           {LearnerKind::kSvm, "svm"},
+           {LearnerKind::kKnn, "knn"},
+           {LearnerKind::kTrees, "trees"}}};
+}
+
+// One learned function of the standardised region feature: a classifier's plane probability or a regressor's
+// value. RVM: the kernel expansion above (a classifier's value is a logit). The others are OpenCV ml models, all
+// with the feature in single precision: SVM (RBF kernel; a classifier's decision value becomes a probability by
+// Platt's sigmoid, fitted on its training rows), kNN (a classifier: the share of planes among the k nearest,
+// (planes + 1) / (k + 2); a regressor: their mean), random trees (a classifier: the share of trees that vote
+// plane; a regressor: the trees' mean). Const evaluation is thread-safe.
+struct Learned {
+  LearnerKind kind = LearnerKind::kRvm;
+  bool classifier = true;
+  RvmFunction rvm;                   // kRvm
+  cv::Ptr<cv::ml::StatModel> ml;     // the others
+  double platt_a = -1, platt_b = 0;  // SVM classifier: p = 1 / (1 + exp(platt_a f + platt_b))
+  int size = 0;                      // relevance or support vectors, stored samples (kNN), tree nodes
+
+  static Learned Rvm(RvmFunction f, bool classifier);
+  // Probabilities (classifier) or values (regressor), one per row; for one row (an RVM's as RvmFunction's
+  // operator(), Evaluate's equal to rounding).
+  Eigen::VectorXd Evaluate(const Eigen::MatrixXd& rows) const;
+  double operator()(const Eigen::VectorXd& x) const;
 };
 
 struct RecogniserOptions {
@@ -78,10 +109,11 @@ struct PlaneModel {
   Eigen::MatrixXd topics;        // (gradient words + colour words) x topics, non-negative
   Eigen::VectorXd feature_mean;  // standardisation of the region features
   Eigen::VectorXd feature_scale;
-  // Each member's value is a logit of the plane probability; the probability is the members' mean (see
-  // Recogniser::Predict). Members are trained on different draws of the training regions (bagging).
-  std::vector<RvmFunction> classifiers;
-  std::array<RvmFunction, 3> normal;  // x, y, z of the normal before normalisation
+  // The plane probability is the mean of the members' (see Recogniser::Predict). Members are trained on
+  // different draws of the training regions (bagging). All classifiers and regressors are of one kind.
+  std::vector<Learned> classifiers;
+  std::array<Learned, 3> normal;  // x, y, z of the normal before normalisation
+  LearnerKind learner() const { return classifiers.empty() ? LearnerKind::kRvm : classifiers.front().kind; }
   ModelCard card;
 
   std::string ToYaml() const;

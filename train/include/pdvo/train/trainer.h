@@ -1,7 +1,7 @@
 // Training the plane recogniser (the paper's section III): regions sampled from annotations -> salient points
 // and descriptors -> two vocabularies (k-means) -> word histograms -> topics (orthogonal NMF) -> spatiograms ->
-// a committee of RVM classifiers and three RVM normal regressors (dlib, Tipping & Faul), kernel widths chosen by
-// cross-validation grouped by image -> one PlaneModel.
+// a committee of RVM classifiers and three RVM normal regressors (dlib, Tipping & Faul; or OpenCV ml's SVM, kNN
+// or random trees), kernel widths (settings) chosen by cross-validation grouped by image -> one PlaneModel.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +30,48 @@ struct RvmOptions {
   bool operator==(const RvmOptions&) const = default;
 };
 
+// OpenCV ml's learners, their settings tried by the same grouped cross-validation as the RVM's kernel width.
+struct SvmOptions {
+  std::vector<double> gammas = {0.2, 0.5};  // RBF widths, gamma = value / feature dimensions
+  std::vector<double> c = {1, 10};          // the soft margin's cost; every (gamma, C) is tried
+  double epsilon = 0.1;                     // the normal regressors' insensitive zone (EPS_SVR)
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("gammas", self.gammas);
+    visit("c", self.c);
+    visit("epsilon", self.epsilon);
+  }
+  bool Check() const;
+  bool operator==(const SvmOptions&) const = default;
+};
+
+struct KnnOptions {
+  std::vector<double> k = {5, 15};  // neighbours (whole numbers), each tried
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("k", self.k);
+  }
+  bool Check() const;
+  bool operator==(const KnnOptions&) const = default;
+};
+
+struct TreesOptions {
+  int trees = 100;
+  std::vector<double> max_depth = {8, 16};  // each tried
+  int min_samples = 2;                      // a node with fewer is not split
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("trees", self.trees);
+    visit("max_depth", self.max_depth);
+    visit("min_samples", self.min_samples);
+  }
+  bool Check() const;
+  bool operator==(const TreesOptions&) const = default;
+};
+
 struct TrainOptions {
   RecogniserOptions recogniser;
   RegionSamplingOptions regions;
@@ -48,7 +90,12 @@ struct TrainOptions {
   // The layout values (see LayoutFeature) count this much more than the others in the kernel's distance: a few
   // values among ~170 would otherwise hardly move it.
   double layout_weight = 6;
+  // The classifiers' and the normal regressors' learner (the committee and all after it as for the RVM).
+  LearnerKind classifier = LearnerKind::kRvm;
   RvmOptions rvm;
+  SvmOptions svm;
+  KnnOptions knn;
+  TreesOptions trees;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -63,7 +110,11 @@ struct TrainOptions {
     visit("max_normal_regions", self.max_normal_regions);
     visit("classifiers", self.classifiers);
     visit("layout_weight", self.layout_weight);
+    visit("classifier", self.classifier);
     visit("rvm", self.rvm);
+    visit("svm", self.svm);
+    visit("knn", self.knn);
+    visit("trees", self.trees);
   }
   bool Check() const;
   bool operator==(const TrainOptions&) const = default;

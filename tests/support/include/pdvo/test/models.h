@@ -1,0 +1,28 @@
+// A small plane model for the model and learner tests: 12 gradient words, 5 colour words, 3 topics and a feature
+// standardisation, all random; no classifiers or regressors yet.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <random>
+
+#include "pdvo/infer/model.h"
+#include "pdvo/infer/recogniser.h"
+
+namespace pdvo::test {
+
+inline PlaneModel RandomModelWithoutLearners(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  cv::Mat g(12, kGradientDims, CV_32F), c(5, kColourDims, CV_32F);
+  cv::randu(g, 0, 100);
+  cv::randu(c, 0, 1);
+  PlaneModel m;
+  m.gradient_words = Vocabulary(g);
+  m.colour_words = Vocabulary(c);
+  m.topics = Eigen::MatrixXd::NullaryExpr(17, 3, [&]() { return u(rng); });
+  const int dims = RegionFeatureDims(3);
+  m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
+  m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
+  return m;
+}
+
+}  // namespace pdvo::test
