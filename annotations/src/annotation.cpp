@@ -12,6 +12,14 @@ namespace pdvo {
 namespace {
 using nlohmann::json;
 
+// What a reader refuses before it recurses or allocates: JSON nested deeper than this (the format needs four
+// levels; copying a deeper document would overflow the stack), and images larger than kMaxImageSide on a side.
+constexpr int kMaxJsonDepth = 64;
+// Polygon points, per shape and per file: the checks that polygons do not cross themselves compare every pair of
+// a shape's edges, so these bound them (to about a second for a file).
+constexpr size_t kMaxShapePoints = 4096;
+constexpr size_t kMaxFilePoints = 100000;
+
 std::string ShapeWhere(const std::string& where, size_t index) { return where + ": shape " + std::to_string(index); }
 
 double Number(const json& value, const std::string& where, const char* key) {
@@ -33,6 +41,8 @@ AnnotationShape ParseShape(const json& j, const std::string& where) {
   shape.label = label.get<std::string>();
   const json& points = Required(j, "points", where);
   PDVO_THROW_CHECK(points.is_array(), FormatError, where << ": 'points' must be a list of [x, y]");
+  PDVO_THROW_CHECK(points.size() <= kMaxShapePoints, FormatError,
+                   where << ": " << points.size() << " points, more than " << kMaxShapePoints << " in a shape");
   for (const json& p : points) {
     PDVO_THROW_CHECK(p.is_array() && p.size() == 2, FormatError, where << ": each point must be [x, y]");
     shape.points.emplace_back(Number(p[0], where, "points"), Number(p[1], where, "points"));
@@ -97,9 +107,15 @@ std::vector<Eigen::Vector2d> Distinct(const std::vector<Eigen::Vector2d>& polygo
 Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   json j;
   try {
-    j = json::parse(text);
+    j = json::parse(text, [&](int depth, json::parse_event_t, json&) {
+      PDVO_THROW_CHECK(depth <= kMaxJsonDepth, FormatError,
+                       where << ": JSON nested deeper than " << kMaxJsonDepth << " levels");
+      return true;
+    });
   } catch (const json::parse_error& e) {
     PDVO_THROW(FormatError, where << ": malformed JSON at byte " << e.byte);
+  } catch (const json::out_of_range&) {
+    PDVO_THROW(FormatError, where << ": a number beyond the range of a double");
   }
   PDVO_THROW_CHECK(j.is_object(), FormatError, where << ": expected a JSON object");
   Annotation a;
@@ -107,8 +123,15 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   const json& image_path = Required(j, "imagePath", where);
   PDVO_THROW_CHECK(image_path.is_string(), FormatError, where << ": 'imagePath' must be text");
   a.image_path = image_path.get<std::string>();
-  a.image_width = static_cast<int>(Number(Required(j, "imageWidth", where), where, "imageWidth"));
-  a.image_height = static_cast<int>(Number(Required(j, "imageHeight", where), where, "imageHeight"));
+  const auto size = [&](const char* key) {
+    const double v = Number(Required(j, key, where), where, key);
+    PDVO_THROW_CHECK(std::abs(v) <= kMaxImageSide && v == std::floor(v), FormatError,
+                     where << ": '" << key << "' must be a whole number of pixels, at most " << kMaxImageSide
+                           << " (got " << v << ")");
+    return static_cast<int>(v);
+  };
+  a.image_width = size("imageWidth");
+  a.image_height = size("imageHeight");
   if (j.contains("camera") && !j["camera"].is_null()) {
     const json& c = j["camera"];
     const std::string cw = where + ": camera";
@@ -124,7 +147,13 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   }
   const json& shapes = Required(j, "shapes", where);
   PDVO_THROW_CHECK(shapes.is_array(), FormatError, where << ": 'shapes' must be a list");
-  for (size_t i = 0; i < shapes.size(); ++i) a.shapes.push_back(ParseShape(shapes[i], ShapeWhere(where, i)));
+  size_t points = 0;
+  for (size_t i = 0; i < shapes.size(); ++i) {
+    a.shapes.push_back(ParseShape(shapes[i], ShapeWhere(where, i)));
+    points += a.shapes.back().points.size();
+    PDVO_THROW_CHECK(points <= kMaxFilePoints, FormatError,
+                     where << ": more than " << kMaxFilePoints << " polygon points in a file");
+  }
   for (const auto& [key, value] : j.items()) {
     if (key != "version" && key != "imagePath" && key != "imageWidth" && key != "imageHeight" && key != "camera" &&
         key != "shapes" && key != "imageData") {

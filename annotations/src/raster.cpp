@@ -15,10 +15,13 @@ std::vector<cv::Point> ScaledPolygon(const AnnotationShape& shape, const Annotat
   const double sy = static_cast<double>(size.height) / a.image_height;
   std::vector<cv::Point> out;
   out.reserve(shape.points.size());
-  for (const auto& p : shape.points) {
-    out.emplace_back(static_cast<int>(std::lround(((p.x() + 0.5) * sx - 0.5) * (1 << kShift))),
-                     static_cast<int>(std::lround(((p.y() + 0.5) * sy - 0.5) * (1 << kShift))));
-  }
+  // Fixed point with kShift fraction bits, bounded before the conversion (10^7 px, 600 times the largest image
+  // side): beyond it only the slopes of edges to far points change.
+  constexpr double bound = 1e7;
+  const auto fixed = [&](double v) {
+    return static_cast<int>(std::lround(std::clamp(v, -bound, bound) * (1 << kShift)));
+  };
+  for (const auto& p : shape.points) out.emplace_back(fixed((p.x() + 0.5) * sx - 0.5), fixed((p.y() + 0.5) * sy - 0.5));
   return out;
 }
 
@@ -37,8 +40,10 @@ cv::Rect BoundingBox(const AnnotationShape& s) {
     x1 = std::max(x1, p.x());
     y1 = std::max(y1, p.y());
   }
-  return cv::Rect(cv::Point(static_cast<int>(std::floor(x0)), static_cast<int>(std::floor(y0))),
-                  cv::Point(static_cast<int>(std::ceil(x1)) + 1, static_cast<int>(std::ceil(y1)) + 1));
+  // Bounded before the conversion (points far outside any image are clipped by the caller anyway).
+  const auto pixel = [](double v) { return static_cast<int>(std::clamp(v, -1e9, 1e9)); };
+  return cv::Rect(cv::Point(pixel(std::floor(x0)), pixel(std::floor(y0))),
+                  cv::Point(pixel(std::ceil(x1)) + 1, pixel(std::ceil(y1)) + 1));
 }
 }  // namespace
 

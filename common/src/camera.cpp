@@ -34,8 +34,15 @@ Camera Camera::Read(const std::string& path) {
 Camera Camera::Read(const cv::FileNode& node, const std::string& where) {
   PDVO_THROW_CHECK(node.isMap(), FormatError, where << ": expected a map with the camera's keys");
   Camera c;
-  c.width = static_cast<int>(ReadNumber(node, "width", where, true, 0));
-  c.height = static_cast<int>(ReadNumber(node, "height", where, true, 0));
+  const auto side = [&](const char* key) {  // checked before the conversion to int
+    const double v = ReadNumber(node, key, where, true, 0);
+    PDVO_THROW_CHECK(v >= 1 && v <= kMaxImageSide && v == std::floor(v), FormatError,
+                     where << ": '" << key << "' must be a whole number of pixels from 1 to " << kMaxImageSide
+                           << " (got " << v << ")");
+    return static_cast<int>(v);
+  };
+  c.width = side("width");
+  c.height = side("height");
   c.fx = ReadNumber(node, "fx", where, true, 0);
   c.fy = ReadNumber(node, "fy", where, true, 0);
   c.cx = ReadNumber(node, "cx", where, true, 0);

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include "pdvo/common/file_io.h"
+
 namespace pdvo {
 namespace detail {
 
@@ -138,9 +140,11 @@ void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& k
 
 cv::FileStorage OpenYamlForReading(const std::string& path) {
   CheckExists(path);
+  const std::string text = ReadFile(path);
+  CheckYamlText(text, path);
   cv::FileStorage fs;
   try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
     PDVO_THROW(FormatError, path << ": not valid YAML (" << e.err << ")");
   }

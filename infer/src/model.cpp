@@ -217,6 +217,7 @@ std::string PlaneModel::ToYaml() const {
 }
 
 PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& where) {
+  CheckYamlText(text, where);
   cv::FileStorage fs;
   try {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

@@ -102,6 +102,30 @@ TEST(Annotation, WrongTypesAndMissingKeysNameShapeAndKey) {
                          "shapes": [{"label": "plane", "points": [], "normal": [1, 2]}]})"),
             "f.json: shape 0: 'normal' must be [nx, ny, nz]");
   EXPECT_EQ(error_of("[1, 2]"), "f.json: expected a JSON object");
+  // Hostile input: refused before it is copied, allocated or converted.
+  std::string deep = R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10, "shapes": [], "mine": )";
+  for (int k = 0; k < 60000; ++k) deep += "{\"a\":";
+  deep += "1" + std::string(60000, '}') + "}";
+  EXPECT_EQ(error_of(deep), "f.json: JSON nested deeper than 64 levels");
+  EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 1e400, "imageHeight": 10, "shapes": []})"),
+            "f.json: a number beyond the range of a double");
+  EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 100000, "imageHeight": 100000, "shapes": []})"),
+            "f.json: 'imageWidth' must be a whole number of pixels, at most 16384 (got 100000)");
+  EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 1e300, "imageHeight": 10, "shapes": []})"),
+            "f.json: 'imageWidth' must be a whole number of pixels, at most 16384 (got 1e+300)");
+  std::string many =
+      R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10, "shapes": [{"label": "plane", "points": [)";
+  for (int k = 0; k < 1000000; ++k) many += (k ? ",[" : "[") + std::to_string(k % 10) + ",1]";
+  EXPECT_EQ(error_of(many + "]}]}"), "f.json: shape 0: 1000000 points, more than 4096 in a shape");
+  std::string shapes = R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10, "shapes": [)";
+  for (int k = 0; k < 30; ++k) {
+    shapes += std::string(k ? "," : "") + R"({"label": "plane", "points": [)";
+    for (int i = 0; i < 4000; ++i) shapes += (i ? ",[" : "[") + std::to_string(i % 10) + ",1]";
+    shapes += "]}";
+  }
+  EXPECT_EQ(error_of(shapes + "]}"), "f.json: more than 100000 polygon points in a file");
+  EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 320.7, "imageHeight": 10, "shapes": []})"),
+            "f.json: 'imageWidth' must be a whole number of pixels, at most 16384 (got 320.7)");
 }
 
 TEST(Annotation, ValidAnnotationHasNoIssues) { EXPECT_TRUE(Validate(Square(10, 10, 20)).empty()); }

@@ -30,6 +30,15 @@ TEST(Raster, MasksCoverExactlyTheShapes) {
   EXPECT_EQ(m.normal.at<cv::Vec3f>(40, 140), cv::Vec3f(0, 0, 0));
 }
 
+TEST(Raster, PointsFarOutsideTheImageAreBoundedNotOverflowed) {
+  // A triangle with corners at 1e300: it covers the whole image (its far edges are far outside it).
+  const Annotation a =
+      test::ImageAnnotation("x.png", 200, 100, {test::Shape(kPlaneLabel, {{-1, -1}, {1e300, -1}, {-1, 1e300}})});
+  const AnnotationMasks m = Rasterise(a);
+  EXPECT_EQ(cv::countNonZero(m.label == kMaskPlane), 200 * 100);
+  EXPECT_EQ(RasteriseShape(a.shapes[0], a, {}).size(), cv::Size(200, 100));
+}
+
 TEST(Raster, HalfResolutionMasksScaleWithPixelCentres) {
   const AnnotationMasks m = Rasterise(TwoShapes(), cv::Size(100, 50));
   // 80 full pixels are 40 half pixels (the edges may round either way).

@@ -51,6 +51,19 @@ TEST(Camera, BadValuesAndUnknownKeysAreErrors) {
   WriteFileAtomically(dir / "b.yaml", "%YAML:1.0\nwidth: 320\nheight: 240\nfx: 3\nfy: 301\ncx: 160\ncy: 1\nk4: 0.1\n");
   EXPECT_THROW(Camera::Read(dir / "b.yaml"), FormatError);
   EXPECT_THROW(Camera::Read(dir / "missing.yaml"), IoError);
+  // Sizes are checked before they become ints or allocate anything.
+  for (const char* width : {"100000", "1e300", "-1e300", "320.7", "0", ".nan"}) {
+    WriteFileAtomically(dir / "c.yaml",
+                        std::string("%YAML:1.0\nwidth: ") + width + "\nheight: 240\nfx: 3\nfy: 3\ncx: 1\ncy: 1\n");
+    try {
+      Camera::Read(dir / "c.yaml");
+      ADD_FAILURE() << width << " was accepted";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("c.yaml: 'width' must be a whole number of pixels from 1 to 16384"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 TEST(Camera, UnprojectInvertsProjectWithStrongDistortion) {

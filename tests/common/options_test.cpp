@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/test/support.h"
 
@@ -130,6 +131,37 @@ TEST(Options, AssignmentsSetTheSameOptionsAgain) {
   OuterOptions again;
   ApplyOverrides(again, assignments);
   EXPECT_EQ(again, o);
+}
+
+// Files that hang OpenCV 4.6's YAML parser (found by fuzzing) or overflow its stack are refused before it sees
+// them, with one line naming the file; the project's own files pass.
+TEST(Options, YamlThatWouldHangOrCrashOpenCvIsRefused) {
+  const test::TempDir dir;
+  const auto message_of = [&](const std::string& text) {
+    WriteFileAtomically(dir / "o.yaml", text);
+    try {
+      LoadOptions<OuterOptions>(dir / "o.yaml");
+    } catch (const FormatError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string where = dir / "o.yaml";
+  EXPECT_EQ(message_of("%YAML:1.\n -g\nm\n-"), where + ": not a YAML map of keys at the top");
+  EXPECT_EQ(message_of("%YAML:1.0\n   uk2: -0.9531\n  p1: -0.0054\n"),
+            where + ": not valid YAML (line 3: did not find expected <document start>)");
+  EXPECT_EQ(message_of("%YAML:1.0\nouter: " + std::string(33000, '[') + std::string(33000, ']') + "\n"),
+            where + ": YAML nested deeper than 64 levels");
+  // Cut short: refused at the end of the input.
+  EXPECT_EQ(message_of("%YAML:1.0\nouter: {scale: [1").rfind(where + ": not valid YAML (line ", 0), 0u);
+  // OpenCV's own header, with and without the document start, and a plain YAML file are taken.
+  EXPECT_NO_THROW(CheckYamlText("%YAML:1.0\n---\na: 1\n", "x"));
+  EXPECT_NO_THROW(CheckYamlText("%YAML:1.0\na: [1, 2]\nb: {c: 3}\n", "x"));
+  EXPECT_NO_THROW(CheckYamlText("a: 1\n", "x"));
+  for (const char* file : {"/vo/config/default.yaml", "/sim/config/default.yaml", "/infer/config/detector.yaml",
+                           "/config/cameras/tum_fr1.yaml", "/models/default/model.yml"}) {
+    EXPECT_NO_THROW(CheckYamlText(ReadFile(std::string(PDVO_SOURCE_DIR) + file), file)) << file;
+  }
 }
 
 TEST(Options, MissingFileIsAnIoError) { EXPECT_THROW(LoadOptions<OuterOptions>("/nonexistent/o.yaml"), IoError); }

@@ -17,6 +17,10 @@
 
 namespace pdvo {
 
+// The largest image side (pixels) the readers of cameras and annotations accept: larger ones are refused
+// before anything is allocated for them.
+inline constexpr int kMaxImageSide = 16384;
+
 struct Camera {
   int width = 0, height = 0;              // pixels
   double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels

@@ -192,7 +192,15 @@ void ApplyOverrides(T& options, const std::vector<std::string>& assignments) {
   }
 }
 
-// Opens a YAML file for reading; throws IoError naming the file if it cannot be opened or parsed.
+// Throws FormatError naming `where` unless `text` may be given to OpenCV's YAML parser, which hangs or overflows
+// its stack on some malformed or deeply nested files (OpenCV 4.6): well-formed YAML as libyaml reads it, a map at
+// the top, nested at most kMaxYamlDepth levels, at most kMaxYamlBytes. OpenCV's header line (%YAML:1.0) is taken.
+inline constexpr int kMaxYamlDepth = 64;
+inline constexpr size_t kMaxYamlBytes = size_t{256} << 20;
+void CheckYamlText(const std::string& text, const std::string& where);
+
+// Opens a YAML file for reading after CheckYamlText; throws IoError or FormatError naming the file if it cannot be
+// read or is not such YAML.
 cv::FileStorage OpenYamlForReading(const std::string& path);
 
 namespace detail {
