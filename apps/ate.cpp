@@ -1,4 +1,5 @@
 // pdvo ate: absolute trajectory error after alignment, and relative pose error.
+#include <cmath>
 #include <cstdio>
 
 #include "pdvo/common/errors.h"
@@ -43,6 +44,11 @@ int RunAte(int argc, char** argv) {
   const Trajectory gt = ReadTrajectory(gt_path, format, gt_times);
   const Trajectory est = ReadTrajectory(est_path, format, est_times);
   const AteResult ate = ComputeAte(gt, est, alignment, max_dt);
+  PDVO_THROW_CHECK(std::isfinite(ate.translation.rmse) && std::isfinite(ate.rotation_deg.rmse) &&
+                       std::isfinite(ate.gt_from_estimate.scale),
+                   FormatError,
+                   est_path << ": the alignment to " << gt_path
+                            << " is undefined (positions that do not spread out, or not finite): no ATE");
   const RpeResult rpe =
       ComputeRpe(gt, est, max_dt, rpe_delta, rpe_unit == "frames" ? RpeUnit::kFrames : RpeUnit::kSeconds,
                  ate.gt_from_estimate.scale);

@@ -20,7 +20,9 @@ int RunCompare(int argc, char** argv) {
   PlaneMatchOptions options;
   app.add_option("--reference,-r", reference_dir, "Folder of reference annotations")->required();
   app.add_option("--estimate,-e", estimate_dir, "Folder of estimated annotations")->required();
-  app.add_option("--min-iou", options.min_iou, "Pairs below this IoU are not matched")->capture_default_str();
+  app.add_option("--min-iou", options.min_iou, "Pairs below this IoU are not matched")
+      ->capture_default_str()
+      ->check(NumberIn(0, 1));
   app.add_option("--json", json_path, "Write the per-frame report as JSON");
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);

@@ -32,7 +32,7 @@ int RunDetect(int argc, char** argv) {
                  "camera; detections are named as the annotations (for pdvo evaluate-detection)");
   app.add_option("--out,-o", out_dir, "Output folder")->required();
   app.add_option("--camera,-c", camera_path, "Camera YAML of the images (default: the sequence's own, if any)");
-  app.add_option("--max-frames", max_frames, "Stop after this many images (0: all)");
+  app.add_option("--max-frames", max_frames, "Stop after this many images (0: all)")->check(NotNegative());
   app.add_flag("--overlay", overlay,
                "Also write <name>_stages.png per image: the windows' plane probability, each point's planarity and "
                "normal, the MRFs' labels (non-planar points white) and the final planes, side by side (the paper's "

@@ -28,7 +28,7 @@ int RunEvaluate(int argc, char** argv) {
                  "truth, plane probability, predicted and true normal in the camera frame)");
   AddConfigFlags(app, &config_path, &overrides, "Region sampling options (YAML, section 'regions')",
                  "windows_per_shape=4");
-  app.add_option("--seed", seed, "Seed for the sub-windows")->capture_default_str();
+  app.add_option("--seed", seed, "Seed for the sub-windows")->capture_default_str()->check(NotNegative());
   app.add_flag("--per-image", per_image, "Print a row per image");
   app.add_flag("--no-fusion", no_fusion,
                "Normals from the regressors alone, not fused with the edges' vanishing direction (as if the model's "

@@ -27,7 +27,7 @@ int RunShow(int argc, char** argv) {
   app.add_option("--out,-o", out_path, "Output image (.png or .jpg)")->required();
   app.add_option("--image", image_path, "Image to draw on (one annotation only; default: its imagePath)");
   app.add_option("--max-width", options.max_width, "Scale larger images down to this width")->capture_default_str();
-  app.add_option("--alpha", options.alpha, "Opacity of the tint, 0-1")->capture_default_str();
+  app.add_option("--alpha", options.alpha, "Opacity of the tint, 0-1")->capture_default_str()->check(NumberIn(0, 1));
   app.add_flag("!--no-legend", options.legend, "Leave out the legend panel");
   app.add_option("--columns", columns, "Contact sheet: tiles per row")
       ->capture_default_str()

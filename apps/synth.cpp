@@ -17,7 +17,7 @@ int RunSynth(int argc, char** argv) {
   uint64_t seed = 1;
   int frames = 300;
   app.add_option("--out,-o", out_dir, "Output folder")->required();
-  app.add_option("--seed", seed, "Scene and walk seed")->capture_default_str();
+  app.add_option("--seed", seed, "Scene and walk seed")->capture_default_str()->check(NotNegative());
   app.add_option("--frames,-n", frames, "Number of frames")->capture_default_str()->check(CLI::PositiveNumber);
   AddConfigFlags(app, &config_path, &overrides, "Options YAML (section synth:, see sim/config/default.yaml)",
                  "street.loop=true --set width=640");

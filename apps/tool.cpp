@@ -1,11 +1,33 @@
 #include "tool.h"
 
 #include <opencv2/core/utils/logger.hpp>
+#include <sstream>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
 
 namespace pdvo::apps {
+
+CLI::Validator NumberIn(double lo, double hi) {
+  std::ostringstream range;
+  range << "a number from " << lo << " to " << hi;
+  return CLI::Validator(
+      [lo, hi, what = range.str()](std::string& text) {
+        double v = 0;
+        std::istringstream in(text);
+        const bool number = static_cast<bool>(in >> v) && (in >> std::ws).eof();
+        return number && v >= lo && v <= hi ? std::string() : "must be " + what + ", got " + text;
+      },
+      range.str());
+}
+
+CLI::Validator NotNegative() {
+  return CLI::Validator(
+      [](std::string& text) {
+        return text.find('-') == std::string::npos ? std::string() : "must not be negative, got " + text;
+      },
+      "NOT NEGATIVE");
+}
 
 void AddVerbosityFlag(CLI::App& app, std::string* verbosity) {
   app.add_option("--verbosity,-v", *verbosity, "Log level: error, warning, info or debug")->capture_default_str();

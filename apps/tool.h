@@ -30,6 +30,11 @@ void ApplyVerbosity(const std::string& verbosity);
     }                                                                                \
   } while (false)
 
+// Flag values CLI11's own checks let through: a number in [lo, hi] (not NaN), and a whole number that is not
+// negative (for unsigned flags, which would otherwise take "-1" as their largest value).
+CLI::Validator NumberIn(double lo, double hi);
+CLI::Validator NotNegative();
+
 // Adds --config FILE and repeatable --set key=value.
 void AddConfigFlags(CLI::App& app, std::string* config_path, std::vector<std::string>* overrides,
                     const std::string& config_help, const std::string& set_example);

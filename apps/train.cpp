@@ -30,7 +30,9 @@ int RunTrain(int argc, char** argv) {
                  "Learner of the classifiers and normal regressors: rvm, svm, knn or trees (default: the options' "
                  "classifier, rvm)")
       ->check(CLI::IsMember({"rvm", "svm", "knn", "trees"}));
-  app.add_option("--seed", seed, "Seed for sampling, k-means, topics and folds")->capture_default_str();
+  app.add_option("--seed", seed, "Seed for sampling, k-means, topics and folds")
+      ->capture_default_str()
+      ->check(NotNegative());
   app.add_option("--cv", folds, "Cross-validation folds (grouped by image) to choose kernel widths; 1: none")
       ->capture_default_str()
       ->check(CLI::Range(1, 20));

@@ -120,7 +120,7 @@ int RunVo(int argc, char** argv) {
                  "output), or a folder of annotation files matched to frames by image name")
       ->capture_default_str();
   app.add_option("--format", format_name, "Trajectory format: tum or kitti")->capture_default_str();
-  app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)");
+  app.add_option("--max-frames", max_frames, "Stop after this many frames (0: all)")->check(NotNegative());
   app.add_flag("--overlay", overlay,
                "Also write overlay.avi: each frame with its features (points green, plane points coloured by "
                "plane; filled where the update used the match, hollow where not found, red where RANSAC "

@@ -180,7 +180,7 @@ Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
 }
 
 bool RecogniserOptions::Check() const {
-  PDVO_CHECK_OPTION(working_width == 0 || working_width >= 32);
+  PDVO_CHECK_OPTION(working_width == 0 || (working_width >= 32 && working_width <= kMaxImageSide));
   PDVO_CHECK_OPTION(features.Check());
   PDVO_CHECK_OPTION(min_points >= 1);
   PDVO_CHECK_OPTION(topic_iterations >= 1);

@@ -89,6 +89,18 @@ TEST(Cli, UsageAndHelp) {
   EXPECT_EQ(missing.code, 1);
   EXPECT_EQ(Lines(missing.err), 1) << missing.err;
   EXPECT_NE(missing.err.find("pdvo ate: error: --est is required"), std::string::npos) << missing.err;
+  // Values CLI11 alone would take: NaN in a range, a negative number for an unsigned flag.
+  const std::pair<const char*, const char*> bad[] = {
+      {"compare -r a -e b --min-iou nan", "--min-iou: must be a number from 0 to 1, got nan"},
+      {"show a.json --alpha 2 --out x.png", "--alpha: must be a number from 0 to 1, got 2"},
+      {"synth -o s --seed -1", "--seed: must not be negative, got -1"},
+      {"vo -s s -o o --max-frames -1", "--max-frames: must not be negative, got -1"}};
+  for (const auto& [args, text] : bad) {
+    const CommandResult r = Pdvo(args, dir);
+    EXPECT_EQ(r.code, 1) << args;
+    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(text), std::string::npos) << r.err;
+  }
 }
 
 TEST(Cli, BadInputsGiveOneLineErrorsNamingTheFile) {

@@ -29,7 +29,7 @@ bool PriorOptions::Check() const {
 }
 
 bool VoOptions::Check() const {
-  PDVO_CHECK_OPTION(working_width == 0 || working_width >= 64);
+  PDVO_CHECK_OPTION(working_width == 0 || (working_width >= 64 && working_width <= kMaxImageSide));
   PDVO_CHECK_OPTION(lost_after >= 1);
   if (!features.Check() || !search.Check() || !ransac.Check() || !prior.Check() || !bootstrap.Check() ||
       !motion.Check() || !planes.Check() || !pdvo.Check()) {
