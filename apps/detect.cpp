@@ -87,7 +87,7 @@ int RunDetect(int argc, char** argv) {
     WriteAnnotation(out.path(name), a);
     if (overlay) {
       const std::string png = out.path(std::filesystem::path(name).stem().string() + "_stages.png");
-      PDVO_THROW_CHECK(cv::imwrite(png, DrawDetectionStages(image, d, a)), IoError, png << ": cannot write");
+      WriteImage(png, DrawDetectionStages(image, d, a));
     }
     for (const AnnotationShape& s : a.shapes) planes += s.IsPlane();
     milliseconds += d.times.total;

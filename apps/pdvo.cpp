@@ -7,6 +7,7 @@
 #include <string>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/file_io.h"
 #include "tool.h"
 
 namespace {
@@ -54,6 +55,7 @@ std::string OneLine(std::string text) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  pdvo::RemoveStagingOnInterrupt();  // first: before any thread starts
   if (argc < 2) {
     PrintUsage(std::cerr);
     return 1;

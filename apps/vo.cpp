@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -167,7 +166,6 @@ int RunVo(int argc, char** argv) {
   if (overlay) {
     video.open(out.path("overlay.avi"), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, cv::Size(width, height));
     PDVO_THROW_CHECK(video.isOpened(), IoError, out.final_path("overlay.avi") << ": cannot open a video writer");
-    std::filesystem::create_directories(out.path("views"));
     if (planes) planes->KeepStages();
   }
   Frame frame;
@@ -212,8 +210,7 @@ int RunVo(int argc, char** argv) {
       const cv::Mat drawn = DrawOverlay(prepared.colour, odometry.observations(), s, odometry.plane_outlines());
       video.write(drawn);
       if (pdvo ? !s.detections.empty() : s.keyframe) {
-        const std::string view = out.path("views/" + FrameName(index) + ".jpg");
-        PDVO_THROW_CHECK(cv::imwrite(view, drawn), IoError, out.final_path("views") << ": cannot write a view");
+        WriteImage(out.path("views/" + FrameName(index) + ".jpg"), drawn);
       }
     }
     progress.SetNote("state " + std::to_string(s.state_size) + ", " + std::to_string(s.points) + " points, " +
@@ -233,7 +230,6 @@ int RunVo(int argc, char** argv) {
   vo::WritePly(out.path("map.ply"), map, trajectory);
   if (planes) {
     const std::map<int, std::vector<unsigned char>> stages = planes->TakeStages();
-    if (!stages.empty()) std::filesystem::create_directories(out.path("stages"));
     for (const auto& [keyframe, jpeg] : stages) {
       WriteFileAtomically(out.path("stages/" + FrameName(keyframe) + ".jpg"), std::string(jpeg.begin(), jpeg.end()));
     }

@@ -1,16 +1,91 @@
 #include "pdvo/common/file_io.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 #include <sstream>
+#include <thread>
 
 #include "pdvo/common/errors.h"
 
 namespace pdvo {
 namespace fs = std::filesystem;
+namespace {
+
+// What an interrupted run removes: the staging folders alive now. The mutex also keeps an interrupt out of a
+// write and a Commit() in progress.
+std::mutex removal_mutex;
+std::set<std::string>& RemoveOnInterrupt() {
+  static std::set<std::string> paths;
+  return paths;
+}
+
+void Register(const std::string& path) {
+  std::lock_guard<std::mutex> lock(removal_mutex);
+  RemoveOnInterrupt().insert(path);
+}
+
+void Unregister(const std::string& path) {
+  std::lock_guard<std::mutex> lock(removal_mutex);
+  RemoveOnInterrupt().erase(path);
+}
+
+// `path` with symbolic links in its last component followed (a dangling link gives the path it points to).
+fs::path FollowLinks(fs::path path) {
+  path = path.lexically_normal();
+  if (!path.has_filename() && path.has_parent_path()) path = path.parent_path();  // "out/" is "out"
+  std::error_code ec;
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(path, ec)); ++hops) {
+    const fs::path target = fs::read_symlink(path, ec);
+    if (ec) break;
+    path = target.is_absolute() ? target : path.parent_path() / target;
+  }
+  return path.lexically_normal();
+}
+
+// Removes the entries of `folder` named `prefix` + PID whose process no longer runs.
+void RemoveStale(const fs::path& folder, const std::string& prefix) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid != getpid() && kill(pid, 0) == -1 && errno == ESRCH) fs::remove_all(entry.path(), ec);
+  }
+}
+
+// Exchanges two paths in one step (Linux renameat2); false where the file system cannot.
+bool ExchangePaths(const fs::path& a, const fs::path& b) {
+  return syscall(SYS_renameat2, AT_FDCWD, a.c_str(), AT_FDCWD, b.c_str(), 2 /* RENAME_EXCHANGE */) == 0;
+}
+
+}  // namespace
+
+void RemoveStagingOnInterrupt() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);  // every thread started later inherits the mask
+  std::thread([signals] {
+    int signal = 0;
+    if (sigwait(&signals, &signal) != 0) return;
+    std::lock_guard<std::mutex> lock(removal_mutex);  // held to the end: a Commit() in progress finishes first
+    std::error_code ec;
+    for (const std::string& path : RemoveOnInterrupt()) fs::remove_all(path, ec);
+    _exit(128 + signal);
+  }).detach();
+}
 
 void CheckExists(const std::string& path, const std::string& what) {
   std::error_code ec;
@@ -18,7 +93,10 @@ void CheckExists(const std::string& path, const std::string& what) {
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& content) {
-  const fs::path target(path);
+  const fs::path target = FollowLinks(path);
+  // Held throughout, so that an interrupt never removes a staging folder while a write (re)creates its folders,
+  // and never leaves a temporary file: it waits until the write is done.
+  std::lock_guard<std::mutex> lock(removal_mutex);
   std::error_code ec;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
   const fs::path tmp = target.string() + ".tmp" + std::to_string(getpid());
@@ -104,13 +182,25 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
   WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
 }
 
-StagedOutputDir::StagedOutputDir(const std::string& final_dir) : final_dir_(final_dir) {
+StagedOutputDir::StagedOutputDir(const std::string& final_dir) {
+  const fs::path target = FollowLinks(fs::absolute(final_dir));
+  final_dir_ = target.string();
   std::error_code ec;
-  created_ = !fs::exists(final_dir);
-  fs::create_directories(final_dir, ec);
-  PDVO_THROW_CHECK(fs::is_directory(final_dir), IoError, final_dir << ": cannot create the output folder");
-  staging_dir_ = (fs::path(final_dir) / (".partial-" + std::to_string(getpid()))).string();
+  if (fs::exists(target, ec)) {
+    PDVO_THROW_CHECK(fs::is_directory(target, ec), IoError, final_dir << ": is a file, expected an output folder");
+    PDVO_THROW_CHECK(fs::is_empty(target, ec) || fs::exists(target / kOutputMarker, ec), IoError,
+                     final_dir << ": is not empty and holds no earlier pdvo output (no " << kOutputMarker
+                               << "); choose a new folder, or empty this one");
+  }
+  const fs::path parent = target.parent_path();
+  fs::create_directories(parent, ec);
+  PDVO_THROW_CHECK(fs::is_directory(parent, ec), IoError, parent.string() << ": cannot create the folder");
+  std::string prefix = target.filename().string();
+  prefix = "." + prefix + ".partial-";
+  RemoveStale(parent, prefix);
+  staging_dir_ = (parent / (prefix + std::to_string(getpid()))).string();
   fs::remove_all(staging_dir_, ec);
+  Register(staging_dir_);
   fs::create_directories(staging_dir_, ec);
   PDVO_THROW_CHECK(!ec, IoError, staging_dir_ << ": cannot create a staging folder");
 }
@@ -118,7 +208,7 @@ StagedOutputDir::StagedOutputDir(const std::string& final_dir) : final_dir_(fina
 StagedOutputDir::~StagedOutputDir() {
   std::error_code ec;
   fs::remove_all(staging_dir_, ec);
-  if (!committed_ && created_) fs::remove(final_dir_, ec);  // only if empty: never what the user made
+  Unregister(staging_dir_);
 }
 
 std::string StagedOutputDir::path(const std::string& name) const { return (fs::path(staging_dir_) / name).string(); }
@@ -128,16 +218,26 @@ std::string StagedOutputDir::final_path(const std::string& name) const {
 }
 
 void StagedOutputDir::Commit() {
+  WriteFileAtomically(path(kOutputMarker), "pdvo output\n");
   std::error_code ec;
-  for (const auto& entry : fs::recursive_directory_iterator(staging_dir_)) {
-    if (!entry.is_regular_file()) continue;
-    const fs::path target = fs::path(final_dir_) / fs::relative(entry.path(), staging_dir_);
-    fs::create_directories(target.parent_path(), ec);
-    fs::rename(entry.path(), target, ec);
-    PDVO_THROW_CHECK(!ec, IoError, target.string() << ": cannot move output into place");
+  {
+    std::lock_guard<std::mutex> lock(removal_mutex);  // an interrupt waits until the folder is whole
+    if (!fs::exists(final_dir_, ec)) {
+      fs::rename(staging_dir_, final_dir_, ec);
+    } else if (!ExchangePaths(staging_dir_, final_dir_)) {
+      // No atomic exchange on this file system: the old folder is moved aside and the new one in. The old one
+      // then goes where the staging folder was (to be removed), or back if the new one could not be moved.
+      const std::string aside = staging_dir_ + ".old";
+      fs::rename(final_dir_, aside, ec);
+      if (!ec) {
+        fs::rename(staging_dir_, final_dir_, ec);
+        std::error_code ignored;
+        fs::rename(aside, ec ? final_dir_ : staging_dir_, ignored);
+      }
+    }
   }
-  fs::remove_all(staging_dir_, ec);
-  committed_ = true;
+  PDVO_THROW_CHECK(!ec, IoError, final_dir_ << ": cannot move the output into place (" << ec.message() << ")");
+  fs::remove_all(staging_dir_, ec);  // what the folder held before
 }
 
 }  // namespace pdvo

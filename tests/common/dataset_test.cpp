@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <vector>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
@@ -45,6 +47,108 @@ TEST(FileIo, AtomicWriteLeavesNoTemporaryFile) {
   int files = 0;
   for (const auto& e : fs::directory_iterator(dir / "sub")) files += e.is_regular_file();
   EXPECT_EQ(files, 1);
+}
+
+// The names in a folder, hidden ones too, sorted.
+std::vector<std::string> Names(const std::string& folder) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(FileIo, AtomicWriteThroughALinkKeepsTheLink) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "real.txt", "old");
+  fs::create_symlink("real.txt", dir / "link.txt");
+  WriteFileAtomically(dir / "link.txt", "new");
+  EXPECT_TRUE(fs::is_symlink(dir / "link.txt"));
+  EXPECT_EQ(ReadFile(dir / "real.txt"), "new");
+  EXPECT_EQ(Names(dir.str()), (std::vector<std::string>{"link.txt", "real.txt"}));
+}
+
+TEST(StagedOutputDir, NothingAppearsBeforeCommitAndNothingIsLeftAfter) {
+  test::TempDir dir;
+  {
+    StagedOutputDir out(dir / "run");
+    WriteFileAtomically(out.path("a.txt"), "1");
+    EXPECT_FALSE(fs::exists(dir / "run"));
+    EXPECT_EQ(out.final_path("a.txt"), (fs::absolute(dir / "run") / "a.txt").string());
+    out.Commit();
+  }
+  EXPECT_EQ(Names(dir.str()), std::vector<std::string>{"run"});  // no staging folder beside it
+  EXPECT_EQ(Names(dir / "run"), (std::vector<std::string>{kOutputMarker, "a.txt"}));
+  { StagedOutputDir failed(dir / "new"); }  // a run that never commits leaves nothing, not even the folder
+  EXPECT_EQ(Names(dir.str()), std::vector<std::string>{"run"});
+}
+
+TEST(StagedOutputDir, ASecondRunReplacesTheFirstWholeAndAFailedOneChangesNothing) {
+  test::TempDir dir;
+  {
+    StagedOutputDir first(dir / "run");
+    WriteFileAtomically(first.path("a.txt"), "first");
+    WriteFileAtomically(first.path("sub/b.txt"), "first");
+    first.Commit();
+  }
+  {
+    StagedOutputDir failed(dir / "run");
+    WriteFileAtomically(failed.path("a.txt"), "failed");
+  }  // no Commit: as if the run threw
+  EXPECT_EQ(ReadFile(dir / "run/a.txt"), "first");
+  EXPECT_EQ(ReadFile(dir / "run/sub/b.txt"), "first");
+  {
+    StagedOutputDir second(dir / "run/");  // a trailing slash names the same folder
+    WriteFileAtomically(second.path("c.txt"), "second");
+    second.Commit();
+  }
+  EXPECT_EQ(Names(dir / "run"), (std::vector<std::string>{kOutputMarker, "c.txt"}));  // nothing of the first
+  EXPECT_EQ(Names(dir.str()), std::vector<std::string>{"run"});
+}
+
+TEST(StagedOutputDir, AFolderPdvoDidNotWriteIsRefusedUntouched) {
+  test::TempDir dir;
+  WriteFileAtomically(dir / "mine/notes.txt", "the user's");
+  try {
+    StagedOutputDir out(dir / "mine");
+    FAIL() << "a foreign folder was accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("mine: is not empty and holds no earlier pdvo output"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(ReadFile(dir / "mine/notes.txt"), "the user's");
+  EXPECT_EQ(Names(dir.str()), std::vector<std::string>{"mine"});
+  WriteFileAtomically(dir / "file", "x");
+  EXPECT_THROW(StagedOutputDir(dir / "file"), IoError);
+  fs::create_directories(dir / "empty");  // an empty folder the user made is fine
+  StagedOutputDir out(dir / "empty");
+  out.Commit();
+  EXPECT_TRUE(fs::exists(fs::path(dir / "empty") / kOutputMarker));
+}
+
+TEST(StagedOutputDir, ALinkToAFolderIsFollowedAndKept) {
+  test::TempDir dir;
+  fs::create_directories(dir / "disk");
+  fs::create_directory_symlink("disk", dir / "run");
+  for (const char* name : {"first.txt", "second.txt"}) {
+    StagedOutputDir out(dir / "run");
+    WriteFileAtomically(out.path(name), name);
+    out.Commit();
+  }
+  EXPECT_TRUE(fs::is_symlink(dir / "run"));
+  EXPECT_EQ(Names(dir / "disk"), (std::vector<std::string>{kOutputMarker, "second.txt"}));
+  EXPECT_EQ(Names(dir.str()), (std::vector<std::string>{"disk", "run"}));
+}
+
+TEST(StagedOutputDir, StagingLeftByADeadProcessIsRemovedALiveOnesIsNot) {
+  test::TempDir dir;
+  const std::string dead = dir / ".run.partial-999999999";  // above any pid_max: no such process
+  const std::string live = dir / ".run.partial-1";          // init always runs
+  const std::string other = dir / ".other.partial-999999999";
+  for (const std::string& folder : {dead, live, other}) WriteFileAtomically(folder + "/x", "x");
+  StagedOutputDir out(dir / "run");
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(other));  // another folder's staging is that folder's business
 }
 
 TEST(Dataset, ImageFolderSortedWithTimes) {

@@ -167,7 +167,7 @@ TEST(Synth, SameSeedSameBytesAndTheTumReaderReadsIt) {
     EXPECT_EQ(ReadFile(e.path().string()), ReadFile((fs::path(dir / "b") / rel).string())) << rel;
     ++files;
   }
-  EXPECT_EQ(files, 6 * 4 + 6);  // rgb, depth, planes, annotation per frame; 6 files per sequence
+  EXPECT_EQ(files, 6 * 4 + 6 + 1);  // rgb, depth, planes, annotation per frame; 6 per sequence; the marker
   EXPECT_NE(ReadFile(dir / "a/rgb/000003.png"), ReadFile(dir / "c/rgb/000003.png"));
 
   auto sequence = OpenSequence(dir / "a");
