@@ -43,7 +43,14 @@ int RunAte(int argc, char** argv) {
   const Alignment alignment = ParseAlignment(align_name);
   const Trajectory gt = ReadTrajectory(gt_path, format, gt_times);
   const Trajectory est = ReadTrajectory(est_path, format, est_times);
-  const AteResult ate = ComputeAte(gt, est, alignment, max_dt);
+  // The library's complaints about the data (too few matches, positions that do not move) are data errors here,
+  // named by the two files.
+  AteResult ate;
+  try {
+    ate = ComputeAte(gt, est, alignment, max_dt);
+  } catch (const InvalidArgument& e) {
+    PDVO_THROW(FormatError, est_path << " against " << gt_path << ": " << e.what());
+  }
   PDVO_THROW_CHECK(std::isfinite(ate.translation.rmse) && std::isfinite(ate.rotation_deg.rmse) &&
                        std::isfinite(ate.gt_from_estimate.scale),
                    FormatError,

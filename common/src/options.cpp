@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -52,6 +53,7 @@ double ParseDouble(const std::string& text, const std::string& where) {
   const auto [ptr, ec] = std::from_chars(text.data(), end, v);
   PDVO_THROW_CHECK(ec == std::errc() && ptr == end, InvalidArgument,
                    where << ": expected a number, got '" << text << "'");
+  PDVO_THROW_CHECK(std::isfinite(v), InvalidArgument, where << ": expected a finite number, got '" << text << "'");
   return v;
 }
 }  // namespace
@@ -73,6 +75,7 @@ void ReadScalar(const cv::FileNode& node, const std::string& where, int& value) 
 void ReadScalar(const cv::FileNode& node, const std::string& where, double& value) {
   PDVO_THROW_CHECK(node.isInt() || node.isReal(), FormatError, where << ": expected a number, got " << TypeName(node));
   value = static_cast<double>(node);
+  PDVO_THROW_CHECK(std::isfinite(value), FormatError, where << ": expected a finite number, got " << value);
 }
 
 void ReadScalar(const cv::FileNode& node, const std::string& where, std::string& value) {
@@ -82,12 +85,15 @@ void ReadScalar(const cv::FileNode& node, const std::string& where, std::string&
 
 void ReadScalar(const cv::FileNode& node, const std::string& where, std::vector<double>& value) {
   PDVO_THROW_CHECK(node.isSeq(), FormatError, where << ": expected a list of numbers, got " << TypeName(node));
-  value.clear();
+  std::vector<double> read;
   for (const cv::FileNode& item : node) {
     PDVO_THROW_CHECK(item.isInt() || item.isReal(), FormatError,
                      where << ": expected a list of numbers, found " << TypeName(item));
-    value.push_back(static_cast<double>(item));
+    read.push_back(static_cast<double>(item));
+    PDVO_THROW_CHECK(std::isfinite(read.back()), FormatError,
+                     where << ": expected a list of finite numbers, found " << read.back());
   }
+  value = std::move(read);
 }
 
 void WriteScalar(cv::FileStorage& fs, const char* key, const bool& value) { fs << key << (value ? "true" : "false"); }
@@ -122,10 +128,11 @@ void ParseScalar(const std::string& text, const std::string& where, double& valu
 void ParseScalar(const std::string& text, const std::string&, std::string& value) { value = text; }
 
 void ParseScalar(const std::string& text, const std::string& where, std::vector<double>& value) {
-  value.clear();
+  std::vector<double> parsed;  // assigned only when every item is a number: a failed override changes nothing
   std::stringstream ss(text);
   std::string item;
-  while (std::getline(ss, item, ',')) value.push_back(ParseDouble(item, where));
+  while (std::getline(ss, item, ',')) parsed.push_back(ParseDouble(item, where));
+  value = std::move(parsed);
 }
 
 void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& known, const std::string& where) {

@@ -165,6 +165,21 @@ TEST(Cli, AteOfAScaledCopy) {
   EXPECT_NEAR(j["ate"]["scale"].get<double>(), 4.0, 1e-6);
   EXPECT_LT(j["ate"]["translation"]["rmse"].get<double>(), 1e-6);
   EXPECT_EQ(j["ate"]["matched"].get<int>(), 50);
+
+  // Data the alignment cannot use is a data error (exit 2) naming both files, and no report is written.
+  Trajectory still = gt, late = gt;
+  for (StampedPose& p : still) p.world_from_cam.translation.setZero();
+  for (StampedPose& p : late) p.timestamp += 100;
+  WriteTrajectory(dir / "still.txt", still, TrajectoryFormat::kTum);
+  WriteTrajectory(dir / "late.txt", late, TrajectoryFormat::kTum);
+  const std::string gt_flag = " --gt " + (dir / "gt.txt") + " --json " + (dir / "bad.json");
+  for (const char* est_name : {"still.txt", "late.txt"}) {
+    const CommandResult bad = Pdvo("ate --est " + (dir / est_name) + gt_flag, dir);
+    EXPECT_EQ(bad.code, 2) << est_name;
+    EXPECT_EQ(Lines(bad.err), 1) << bad.err;
+    EXPECT_NE(bad.err.find(std::string(est_name) + " against " + (dir / "gt.txt")), std::string::npos) << bad.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "bad.json"));
 }
 
 TEST(Cli, AnnotateDepthWritesValidAnnotationsAndNothingOnFailure) {

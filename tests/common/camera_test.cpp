@@ -52,7 +52,7 @@ TEST(Camera, BadValuesAndUnknownKeysAreErrors) {
   EXPECT_THROW(Camera::Read(dir / "b.yaml"), FormatError);
   EXPECT_THROW(Camera::Read(dir / "missing.yaml"), IoError);
   // Sizes are checked before they become ints or allocate anything.
-  for (const char* width : {"100000", "1e300", "-1e300", "320.7", "0", ".nan"}) {
+  for (const char* width : {"100000", "1e300", "-1e300", "320.7", "0"}) {
     WriteFileAtomically(dir / "c.yaml",
                         std::string("%YAML:1.0\nwidth: ") + width + "\nheight: 240\nfx: 3\nfy: 3\ncx: 1\ncy: 1\n");
     try {
@@ -63,6 +63,13 @@ TEST(Camera, BadValuesAndUnknownKeysAreErrors) {
                 std::string::npos)
           << e.what();
     }
+  }
+  WriteFileAtomically(dir / "c.yaml", "%YAML:1.0\nwidth: .nan\nheight: 240\nfx: 3\nfy: 3\ncx: 1\ncy: 1\n");
+  try {
+    Camera::Read(dir / "c.yaml");
+    ADD_FAILURE() << "a NaN width was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("c.yaml.width: expected a finite number"), std::string::npos) << e.what();
   }
 }
 

@@ -88,6 +88,26 @@ TEST(Options, WrongTypeIsAnError) {
   EXPECT_THROW(LoadOptions<OuterOptions>(dir / "o.yaml"), FormatError);
 }
 
+TEST(Options, NonFiniteNumbersAreRefusedNamingTheOption) {
+  test::TempDir dir;
+  for (const char* value : {".inf", "-.Inf", ".nan"}) {
+    WriteFileAtomically(dir / "o.yaml", std::string("%YAML:1.0\nthreshold: ") + value + "\n");
+    try {
+      LoadOptions<OuterOptions>(dir / "o.yaml");
+      ADD_FAILURE() << value << " was accepted";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("threshold: expected a finite number"), std::string::npos) << e.what();
+    }
+  }
+  WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  weights: [1, .inf]\n");
+  EXPECT_THROW(LoadOptions<OuterOptions>(dir / "o.yaml"), FormatError);
+  OuterOptions o;
+  for (const char* assignment : {"threshold=inf", "threshold=nan", "threshold=1e400", "inner.weights=1,inf"}) {
+    EXPECT_THROW(ApplyOverrides(o, {assignment}), InvalidArgument) << assignment;
+  }
+  EXPECT_EQ(o, OuterOptions());
+}
+
 TEST(Options, CheckRejectsBadValues) {
   test::TempDir dir;
   WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  iterations: 0\n");
