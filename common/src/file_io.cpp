@@ -195,8 +195,7 @@ StagedOutputDir::StagedOutputDir(const std::string& final_dir) {
   const fs::path parent = target.parent_path();
   fs::create_directories(parent, ec);
   PDVO_THROW_CHECK(fs::is_directory(parent, ec), IoError, parent.string() << ": cannot create the folder");
-  std::string prefix = target.filename().string();
-  prefix = "." + prefix + ".partial-";
+  const std::string prefix = std::string(".").append(target.filename().string()).append(".partial-");
   RemoveStale(parent, prefix);
   staging_dir_ = (parent / (prefix + std::to_string(getpid()))).string();
   fs::remove_all(staging_dir_, ec);

@@ -29,8 +29,11 @@ int RunPdvo(const std::string& args) {
   return WEXITSTATUS(status);
 }
 
-// Starts `pdvo <args>`, waits until `ready()` holds (at most 60 s), sends `signal`, and returns the exit status
-// as a shell gives it (128 + the signal for a process the signal ended). -1 if the run ended before it was ready.
+// Starts `pdvo <args>`, waits until `ready()` holds (at most 60 s), sends `signal`, and returns the exit code.
+// -1 if the run ended before it was ready; kKilled if the signal's default action ended it (no cleanup ran), so
+// that an exit code of 130 or 143 proves pdvo took the signal and cleaned up.
+constexpr int kKilled = -3;
+
 template <class Ready>
 int Interrupt(const std::string& args, int signal, Ready ready) {
   const std::string command = "exec " + std::string(PDVO_BINARY) + " " + args + " > /dev/null 2>&1";
@@ -46,8 +49,7 @@ int Interrupt(const std::string& args, int signal, Ready ready) {
   }
   kill(pid, signal);
   waitpid(pid, &status, 0);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);  // killed by the default action: no cleanup ran
-  return WEXITSTATUS(status);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : kKilled;
 }
 
 // Every file under `folder` (hidden ones too) with its content.
