@@ -39,7 +39,9 @@ int RunAnnotateDepth(int argc, char** argv) {
 
   const auto options = LoadToolOptions<DepthPlaneOptions>(config_path, "annotate_depth", overrides);
 
-  std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
+  SequenceOptions reading;  // depth maps, not ground truth
+  reading.load_groundtruth = false;
+  std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path, reading);
   const Camera camera = SequenceCamera(*sequence, sequence_path, camera_path);
   const DepthPlaneFinder finder(camera, options);
   PDVO_LOG(Info) << "annotating " << sequence->Describe() << " at " << finder.working_size().width << "x"
@@ -66,7 +68,9 @@ int RunAnnotateDepth(int argc, char** argv) {
     shapes += annotation.shapes.size();
     const fs::path reference_file = fs::path(reference_dir) / name;
     if (!reference_dir.empty() && fs::exists(reference_file)) {
-      PlaneComparison c = ComparePlanes(ReadAnnotation(reference_file.string()), annotation);
+      const Annotation reference = ReadAnnotation(reference_file.string());
+      CheckSameImageSize(reference, reference_file.string(), annotation, out.final_path(name));
+      PlaneComparison c = ComparePlanes(reference, annotation);
       c.name = name;
       comparisons.push_back(std::move(c));
     }

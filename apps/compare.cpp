@@ -36,7 +36,9 @@ int RunCompare(int argc, char** argv) {
     const fs::path est_path = fs::path(estimate_dir) / fs::path(ref_path).filename();
     PlaneComparison c;
     if (fs::exists(est_path)) {
-      c = ComparePlanes(reference, ReadAnnotation(est_path.string()), options);
+      const Annotation estimate = ReadAnnotation(est_path.string());
+      CheckSameImageSize(reference, ref_path, estimate, est_path.string());
+      c = ComparePlanes(reference, estimate, options);
     } else {
       ++missing;
       for (const AnnotationShape& s : reference.shapes) c.reference_planes += s.IsPlane();

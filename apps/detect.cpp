@@ -61,7 +61,9 @@ int RunDetect(int argc, char** argv) {
   } else if (std::filesystem::is_regular_file(input) && HasImageExtension(input)) {
     single.emplace_back(input, ReadImage(input, cv::IMREAD_COLOR));
   } else {
-    sequence = OpenSequence(input);
+    SequenceOptions reading;  // the images only
+    reading.load_depth = reading.load_groundtruth = false;
+    sequence = OpenSequence(input, reading);
     if (!camera) camera = sequence->camera();
     total = sequence->size();
     PDVO_THROW_CHECK(total > 0, FormatError, input << ": no images");

@@ -54,10 +54,7 @@ int RunEvaluateDetection(int argc, char** argv) {
         estimate.image_width = reference.image_width;
         estimate.image_height = reference.image_height;
       }
-      PDVO_THROW_CHECK(
-          estimate.image_width == reference.image_width && estimate.image_height == reference.image_height, FormatError,
-          est_path.string() << ": the image is " << estimate.image_width << "x" << estimate.image_height
-                            << ", its reference " << reference.image_width << "x" << reference.image_height);
+      CheckSameImageSize(reference, ref_path, estimate, est_path.string());
       DetectionScore s = ScoreDetection(reference, estimate, options);
       s.name = ref_path;
       scores.push_back(std::move(s));

@@ -26,7 +26,9 @@ int RunShow(int argc, char** argv) {
   app.add_option("annotations", annotation_paths, "Annotation files (LabelMe JSON with normals)")->required();
   app.add_option("--out,-o", out_path, "Output image (.png or .jpg)")->required();
   app.add_option("--image", image_path, "Image to draw on (one annotation only; default: its imagePath)");
-  app.add_option("--max-width", options.max_width, "Scale larger images down to this width")->capture_default_str();
+  app.add_option("--max-width", options.max_width, "Scale larger images down to this width")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--alpha", options.alpha, "Opacity of the tint, 0-1")->capture_default_str()->check(NumberIn(0, 1));
   app.add_flag("!--no-legend", options.legend, "Leave out the legend panel");
   app.add_option("--columns", columns, "Contact sheet: tiles per row")
@@ -47,6 +49,9 @@ int RunShow(int argc, char** argv) {
     ValidateOrThrow(annotation, path);
     const std::string image_file = image_path.empty() ? ResolveImagePath(annotation, path) : image_path;
     const cv::Mat image = ReadImage(image_file, cv::IMREAD_COLOR);
+    PDVO_THROW_CHECK(image.cols == annotation.image_width && image.rows == annotation.image_height, FormatError,
+                     image_file << ": the image is " << image.cols << "x" << image.rows << ", " << path << " says "
+                                << annotation.image_width << "x" << annotation.image_height);
     cv::Mat tile = DrawOverlay(image, annotation, tile_options);
     if (with_image) {
       cv::Mat plain;

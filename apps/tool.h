@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pdvo/annotations/annotation.h"
 #include "pdvo/common/camera.h"
 #include "pdvo/common/dataset.h"
 #include "pdvo/common/options.h"
@@ -54,6 +55,10 @@ Options LoadToolOptions(const std::string& config_path, const std::string& secti
 // The camera of a sequence: from `camera_path` if given, else the sequence's own; throws naming the file, or
 // the sequence that holds none.
 Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path, const std::string& camera_path);
+
+// Throws FormatError naming both files unless the two annotations are of images of one size.
+void CheckSameImageSize(const Annotation& reference, const std::string& reference_path, const Annotation& estimate,
+                        const std::string& estimate_path);
 
 // Every .json file among the given files and folders (folders not recursed), sorted; throws IoError for a
 // missing path and FormatError for a folder without annotations.

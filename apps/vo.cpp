@@ -91,6 +91,49 @@ nlohmann::json DetectionJson(const vo::DetectionEvent& e, double now) {
   return j;
 }
 
+// stats.json, written as the frames go (a line per frame; the keyframes' detections wait in a file beside it until
+// the end), so that memory does not grow with the number of frames. Readers see one ordinary JSON object.
+class StatsFile {
+ public:
+  // `path`: where to write (in the staging folder); `shown`: the name errors give. `head`: the first keys.
+  StatsFile(std::string path, std::string shown, const nlohmann::json& head)
+      : path_(std::move(path)), shown_(std::move(shown)), out_(path_), detections_(path_ + ".detections") {
+    PDVO_THROW_CHECK(out_ && detections_, IoError, shown_ << ": cannot write");
+    out_ << "{";
+    for (const auto& [key, value] : head.items())
+      out_ << "\n " << nlohmann::json(key).dump() << ": " << value.dump() << ",";
+    out_ << "\n \"frames\": [";
+  }
+  void AddFrame(const nlohmann::json& frame) { out_ << (frames_++ > 0 ? ",\n  " : "\n  ") << frame.dump(); }
+  void AddDetection(const nlohmann::json& detection) {
+    detections_ << (detections_written_++ > 0 ? ",\n  " : "\n  ") << detection.dump();
+  }
+  // Ends the file: the detections (if `with_detections`), then `tail`'s keys.
+  void Finish(const nlohmann::json& tail, bool with_detections) {
+    out_ << "\n ]";
+    detections_.close();
+    PDVO_THROW_CHECK(detections_, IoError, shown_ << ": cannot write");
+    if (with_detections) {
+      out_ << ",\n \"detections\": [";
+      if (detections_written_ > 0) out_ << std::ifstream(path_ + ".detections").rdbuf();
+      out_ << "\n ]";
+    }
+    std::filesystem::remove(path_ + ".detections");
+    for (const auto& [key, value] : tail.items()) {
+      out_ << ",\n " << nlohmann::json(key).dump() << ": ";
+      for (const char c : value.dump(1)) out_ << c << (c == '\n' ? " " : "");  // indented one level
+    }
+    out_ << "\n}\n";
+    out_.close();
+    PDVO_THROW_CHECK(out_, IoError, shown_ << ": cannot write (disk full?)");
+  }
+
+ private:
+  std::string path_, shown_;
+  std::ofstream out_, detections_;
+  size_t frames_ = 0, detections_written_ = 0;
+};
+
 }  // namespace
 
 int RunVo(int argc, char** argv) {
@@ -138,7 +181,9 @@ int RunVo(int argc, char** argv) {
   if (!mode.empty()) overrides.push_back("mode=" + mode);
   const vo::VoOptions options = LoadToolOptions<vo::VoOptions>(config_path, "vo", overrides);
   const TrajectoryFormat format = ParseTrajectoryFormat(format_name);
-  std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path);
+  SequenceOptions reading;  // the images and their times: depth maps and ground truth are not read
+  reading.load_depth = reading.load_groundtruth = false;
+  std::unique_ptr<Sequence> sequence = OpenSequence(sequence_path, reading);
   const Camera camera = SequenceCamera(*sequence, sequence_path, camera_path);
   const vo::FramePreparer preparer(camera, options.working_width);
   const Camera& working = preparer.working_camera();
@@ -153,7 +198,9 @@ int RunVo(int argc, char** argv) {
   StagedOutputDir out(out_dir);
   SaveOptions(out.path("vo.yaml"), options, "vo");
   size_t tracked = 0;
-  nlohmann::json frames = nlohmann::json::array(), detections = nlohmann::json::array();
+  StatsFile stats(out.path("stats.json"), out.final_path("stats.json"),
+                  {{"sequence", sequence_path}, {"mode", OptionName(options.mode)}});
+  int keyframes_detected = 0, planes_detected = 0, planes_seeded = 0;
   // The paper's Fig. 4; planes are matched to their keyframe's frame by its timestamp.
   vo::MeasurementCurve measured_after(kCurveFrames, options.planes.min_plane_points);
   std::vector<double> times;
@@ -178,7 +225,10 @@ int RunVo(int argc, char** argv) {
     if (planes) planes->AddFrame(static_cast<int>(index), frame.image_path);
     const vo::FrameStats s = odometry.Track(prepared.grey, frame.timestamp, prepared.colour);
     for (const vo::DetectionEvent& e : s.detections) {
-      detections.push_back(DetectionJson(e, frame.timestamp));
+      stats.AddDetection(DetectionJson(e, frame.timestamp));
+      ++keyframes_detected;
+      planes_detected += static_cast<int>(e.result.planes.size());
+      planes_seeded += e.seeding.seeded;
       keyframes_gone += e.keyframe_gone;
     }
     times.push_back(frame.timestamp);
@@ -192,19 +242,20 @@ int RunVo(int argc, char** argv) {
     lost += s.lost;
     keyframes += s.keyframe;
     waited += s.detector_wait_seconds;
-    frames.push_back({{"t", s.timestamp},
-                      {"seconds", s.seconds},
-                      {"attempted", s.attempted},
-                      {"measurements", s.measurements},
-                      {"points", s.points},
-                      {"planes", s.planes},
-                      {"plane_points", s.plane_points},
-                      {"plane_measurements", s.plane_measurements},
-                      {"state", s.state_size},
-                      {"keyframe", s.keyframe},
-                      {"lost", s.lost},
-                      {"bootstrap", s.bootstrap},
-                      {"update", vo::ToString(s.update)}});
+    stats.AddFrame({{"t", s.timestamp},
+                    {"seconds", s.seconds},
+                    {"attempted", s.attempted},
+                    {"measurements", s.measurements},
+                    {"points", s.points},
+                    {"planes", s.planes},
+                    {"plane_points", s.plane_points},
+                    {"plane_measurements", s.plane_measurements},
+                    {"state", s.state_size},
+                    {"keyframe", s.keyframe},
+                    {"lost", s.lost},
+                    {"bootstrap", s.bootstrap},
+                    {"update", vo::ToString(s.update)},
+                    {"resident_mib", ResidentMiB()}});
     update_failures += s.update != vo::UpdateStatus::kOk && s.update != vo::UpdateStatus::kNoMeasurements;
     if (overlay) {
       const cv::Mat drawn = DrawOverlay(prepared.colour, odometry.observations(), s, odometry.plane_outlines());
@@ -247,33 +298,23 @@ int RunVo(int argc, char** argv) {
                                  {"mean_plane_area_px", mapping.mean_plane_area},
                                  {"map_points", map.points.size()},
                                  {"map_planes", map.planes.size()}};
-  nlohmann::json stats = {{"sequence", sequence_path},
-                          {"mode", OptionName(options.mode)},
-                          {"totals", totals},
-                          {"plane_measurements_after_keyframe", measured_after.Mean()},
-                          {"frames", frames}};
+  nlohmann::json tail = {{"totals", totals}, {"plane_measurements_after_keyframe", measured_after.Mean()}};
   if (pdvo) {
     const vo::Odometry::DetectionCounts counts = odometry.detection_counts();
-    int detected = 0, seeded = 0;
-    for (const nlohmann::json& d : detections) {
-      detected += d["detected"].get<int>();
-      seeded += d["seeded"].get<int>();
-    }
-    stats["totals"]["detections"] = {{"keyframes_detected", detections.size()},
-                                     {"skipped", counts.skipped},
-                                     {"timed_out", counts.timed_out},
-                                     {"failed", counts.failed},
-                                     {"keyframe_gone", keyframes_gone},
-                                     {"planes_detected", detected},
-                                     {"planes_seeded", seeded}};
-    stats["totals"]["detector_wait_seconds"] = waited;
-    stats["detections"] = detections;
+    tail["totals"]["detections"] = {{"keyframes_detected", keyframes_detected},
+                                    {"skipped", counts.skipped},
+                                    {"timed_out", counts.timed_out},
+                                    {"failed", counts.failed},
+                                    {"keyframe_gone", keyframes_gone},
+                                    {"planes_detected", planes_detected},
+                                    {"planes_seeded", planes_seeded}};
+    tail["totals"]["detector_wait_seconds"] = waited;
     if (counts.timed_out > 0) {
       PDVO_LOG(Warning) << "vo: " << counts.timed_out << " detections took longer than pdvo.timeout_seconds and "
                         << "were given up: the trajectory may differ from run to run";
     }
   }
-  WriteFileAtomically(out.path("stats.json"), stats.dump(1) + "\n");
+  stats.Finish(tail, pdvo);
   out.Commit();
   std::printf(
       "%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times; %d planes, "

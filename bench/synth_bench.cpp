@@ -7,11 +7,11 @@
 #include <cstdlib>
 #include <string>
 
-#include "memory.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
 
-using pdvo::bench::ResidentMiB;
+using pdvo::ResidentMiB;
 
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 2000;

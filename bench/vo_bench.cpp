@@ -19,9 +19,9 @@
 #include <set>
 
 #include "pdvo/common/geometry.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
 
-#include "memory.h"
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/eval/plane_match.h"
 #include "pdvo/eval/trajectory_error.h"
@@ -31,7 +31,7 @@
 #include "pdvo/vo/frames.h"
 #include "pdvo/vo/odometry.h"
 
-using pdvo::bench::ResidentMiB;
+using pdvo::ResidentMiB;
 
 namespace {
 double ThreadSeconds() {

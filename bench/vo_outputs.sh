@@ -7,8 +7,8 @@
 #
 # Usage: bench/vo_outputs.sh record PDVO WORK OUT    runs PDVO vo on every input, writes OUT/<input>_<mode>/
 #        bench/vo_outputs.sh compare A B             compares two records: trajectory.txt byte for byte, and
-#                                                    stats.json without its times (seconds, tracking_seconds,
-#                                                    fps) and without the keys listed in NEW_KEYS (keys the
+#                                                    stats.json without its times (seconds, fps, ...), its
+#                                                    resident memory and the keys listed in NEW_KEYS (keys the
 #                                                    newer record adds, e.g. NEW_KEYS="update"); exit 1 if any
 #                                                    differ
 # e.g. bench/vo_outputs.sh record /tmp/pdvo_before out/vo_outputs out/vo_outputs/before
@@ -52,12 +52,11 @@ record() {
   done
 }
 
-# stats.json without its times and the named new keys (one key per line: dumped with an indent), and without
-# the commas at the ends of lines (which depend on the keys that follow).
+# stats.json without its times, resident memory and the named new keys, and without the commas these leave.
 stats_without_times() {
-  local pattern='"(seconds|tracking_seconds|fps)":'
-  [ -n "${NEW_KEYS:-}" ] && pattern="\"(seconds|tracking_seconds|fps|${NEW_KEYS// /|})\":"
-  grep -vE "$pattern" "$1" | sed 's/,$//'
+  local keys="seconds|tracking_seconds|fps|resident_mib|detector_seconds|latency_seconds|detector_wait_seconds"
+  [ -n "${NEW_KEYS:-}" ] && keys="$keys|${NEW_KEYS// /|}"
+  sed -E "s/\"($keys)\": ?(\"[^\"]*\"|[-+0-9.eE]+|true|false|null),?//g; s/,([]}])/\1/g; s/,$//" "$1"
 }
 
 compare() {

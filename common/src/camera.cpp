@@ -27,8 +27,10 @@ double ReadNumber(const cv::FileNode& node, const char* key, const std::string& 
 
 Camera Camera::Read(const std::string& path) {
   cv::FileStorage fs = OpenYamlForReading(path);
-  const cv::FileNode camera_node = fs["camera"];
-  return camera_node.isMap() ? Read(camera_node, path + ": camera") : Read(fs.root(), path);
+  return WithOpenCvErrorsNamed(path, [&] {
+    const cv::FileNode camera_node = fs["camera"];
+    return camera_node.isMap() ? Read(camera_node, path + ": camera") : Read(fs.root(), path);
+  });
 }
 
 Camera Camera::Read(const cv::FileNode& node, const std::string& where) {
@@ -54,7 +56,11 @@ Camera Camera::Read(const cv::FileNode& node, const std::string& where) {
     known.insert(kDistortionKeys[i]);
   }
   detail::ThrowIfUnknownKeys(node, known, where);
-  c.Check(where);
+  try {
+    c.Check(where);
+  } catch (const InvalidArgument& e) {  // a file's fault: a data error
+    PDVO_THROW(FormatError, e.what());
+  }
   return c;
 }
 

@@ -106,7 +106,7 @@ std::unique_ptr<Sequence> OpenTum(const fs::path& root, const SequenceOptions& o
   }
   Trajectory gt;
   std::vector<double> gt_times;
-  if (fs::exists(root / "groundtruth.txt")) {
+  if (options.load_groundtruth && fs::exists(root / "groundtruth.txt")) {
     gt = ReadTrajectory((root / "groundtruth.txt").string(), TrajectoryFormat::kTum);
     for (const StampedPose& p : gt) gt_times.push_back(p.timestamp);
   }
@@ -131,7 +131,7 @@ std::unique_ptr<Sequence> OpenTum(const fs::path& root, const SequenceOptions& o
   return std::make_unique<ListedSequence>("TUM RGB-D folder", root.string(), std::move(entries), camera, depth_scale);
 }
 
-std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
+std::unique_ptr<Sequence> OpenKitti(const fs::path& root, const SequenceOptions& options) {
   // calib.txt: lines of 12 numbers, optionally labelled "P0:"; the first is the left camera.
   const std::string calib_path = (root / "calib.txt").string();
   std::vector<double> p0;
@@ -168,7 +168,8 @@ std::unique_ptr<Sequence> OpenKitti(const fs::path& root) {
   std::vector<double> times;
   if (fs::exists(root / "times.txt")) times = ReadTimes((root / "times.txt").string());
   Trajectory poses;
-  if (fs::exists(root / "poses.txt")) poses = ReadTrajectory((root / "poses.txt").string(), TrajectoryFormat::kKitti);
+  if (options.load_groundtruth && fs::exists(root / "poses.txt"))
+    poses = ReadTrajectory((root / "poses.txt").string(), TrajectoryFormat::kKitti);
   PDVO_THROW_CHECK(times.empty() || times.size() >= images.size(), FormatError,
                    (root / "times.txt").string()
                        << ": " << times.size() << " times for " << images.size() << " images");
@@ -277,7 +278,7 @@ std::unique_ptr<Sequence> OpenSequence(const std::string& path, const SequenceOp
   const fs::path root(path);
   if (fs::is_directory(root)) {
     if (fs::exists(root / "rgb.txt")) return OpenTum(root, options);
-    if (fs::exists(root / "calib.txt")) return OpenKitti(root);
+    if (fs::exists(root / "calib.txt")) return OpenKitti(root, options);
     return OpenImageFolder(root, options);
   }
   return std::make_unique<VideoSequence>(path, options.fps);

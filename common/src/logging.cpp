@@ -5,12 +5,21 @@
 #include <atomic>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 
 #include "pdvo/common/errors.h"
 
 namespace pdvo {
+
+double ResidentMiB() {
+  std::ifstream statm("/proc/self/statm");
+  long pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1 << 20);
+}
+
 namespace {
 std::atomic<int> g_log_level{static_cast<int>(LogLevel::kInfo)};
 std::mutex g_stderr_mutex;

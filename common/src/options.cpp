@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "pdvo/common/file_io.h"
 
@@ -154,8 +155,12 @@ cv::FileStorage OpenYamlForReading(const std::string& path) {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
     PDVO_THROW(FormatError, path << ": not valid YAML (" << e.err << ")");
+  } catch (const std::length_error& e) {  // OpenCV's parser on some malformed keys (found by fuzzing)
+    PDVO_THROW(FormatError, path << ": not valid YAML (OpenCV's parser failed: " << e.what() << ")");
   }
   PDVO_THROW_CHECK(fs.isOpened(), IoError, path << ": cannot open as YAML");
+  // OpenCV's parser does not always read what libyaml reads (e.g. "-a : b" is a map to one, a list to the other).
+  PDVO_THROW_CHECK(fs.root().isMap(), FormatError, path << ": not a YAML map of keys (as OpenCV reads it)");
   return fs;
 }
 

@@ -2,12 +2,48 @@
 // which keeps its own stack and so neither recurses nor hangs.
 #include <yaml.h>
 
+#include <cctype>
 #include <memory>
+#include <regex>
+#include <string_view>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/options.h"
 
 namespace pdvo {
+namespace {
+
+int Base64Value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  return c == '+' ? 62 : c == '/' ? 63 : -1;
+}
+
+// Whether `value` (a !!binary scalar) is what OpenCV writes for a matrix: base64 whose first 24 bytes are the
+// element type ("1f", "3d", "2i1f", ...) padded with spaces. OpenCV's reader loops without end on some other
+// headers (found by fuzzing).
+bool IsOpenCvBase64(std::string_view value) {
+  std::string digits;  // the base64 characters, without line breaks, spaces and padding
+  for (const char c : value) {
+    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (c == '=') break;
+    if (Base64Value(c) < 0) return false;
+    digits += c;
+  }
+  if (digits.size() < 32) return false;
+  std::string header;
+  for (size_t i = 0; i < 32; i += 4) {
+    const int v = Base64Value(digits[i]) << 18 | Base64Value(digits[i + 1]) << 12 | Base64Value(digits[i + 2]) << 6 |
+                  Base64Value(digits[i + 3]);
+    header += static_cast<char>(v >> 16 & 255), header += static_cast<char>(v >> 8 & 255),
+        header += static_cast<char>(v & 255);
+  }
+  static const std::regex kHeader("([0-9]*[ucwsifdhr])+[ \\0]*");
+  return std::regex_match(header, kHeader);
+}
+
+}  // namespace
 
 void CheckYamlText(const std::string& text, const std::string& where) {
   PDVO_THROW_CHECK(
@@ -28,7 +64,17 @@ void CheckYamlText(const std::string& text, const std::string& where) {
                      where << ": not valid YAML (line " << parser.problem_mark.line + 1 << ": "
                            << (parser.problem ? parser.problem : "unreadable") << ")");
     const yaml_event_type_t type = event.type;
+    const bool binary =
+        type == YAML_SCALAR_EVENT && event.data.scalar.tag &&
+        std::string_view(reinterpret_cast<const char*>(event.data.scalar.tag)) == "tag:yaml.org,2002:binary";
+    const bool readable =
+        !binary || IsOpenCvBase64(std::string_view(reinterpret_cast<const char*>(event.data.scalar.value),
+                                                   event.data.scalar.length));
+    const size_t line = event.start_mark.line + 1;
     yaml_event_delete(&event);
+    PDVO_THROW_CHECK(
+        readable, FormatError,
+        where << ": line " << line << ": binary data that is not an OpenCV matrix's (base64 with its type)");
     if (type == YAML_STREAM_END_EVENT) break;
     if (top && (type == YAML_SCALAR_EVENT || type == YAML_SEQUENCE_START_EVENT || type == YAML_ALIAS_EVENT)) {
       PDVO_THROW(FormatError, where << ": not a YAML map of keys at the top");

@@ -1,16 +1,55 @@
 #include "pdvo/infer/model.h"
 
+#include <zlib.h>
+
 #include <cmath>
+#include <cstdio>
 #include <opencv2/core/eigen.hpp>
+#include <stdexcept>
+#include <string_view>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
 
 namespace pdvo {
 namespace {
 
 constexpr const char* kEndMarker = "end_of_model";
+constexpr std::string_view kChecksumPrefix = "# crc32: ";
+
+std::string Crc32Hex(std::string_view bytes) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  for (size_t at = 0; at < bytes.size(); at += 1 << 30) {  // zlib takes lengths as uInt
+    const size_t n = std::min<size_t>(bytes.size() - at, 1 << 30);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes.data() + at), static_cast<uInt>(n));
+  }
+  char hex[9];
+  std::snprintf(hex, sizeof hex, "%08lx", crc & 0xffffffffUL);
+  return hex;
+}
+
+// Where the last line of `text` starts (the checksum line, if there is one).
+size_t LastLineStart(std::string_view text) {
+  const size_t end = !text.empty() && text.back() == '\n' ? text.size() - 1 : text.size();
+  const size_t newline = end == 0 ? std::string_view::npos : text.rfind('\n', end - 1);
+  return newline == std::string_view::npos ? 0 : newline + 1;
+}
+
+// Whether `text` ends with a checksum line; throws when it does and the checksum does not match.
+bool VerifyChecksum(std::string_view text, const std::string& where) {
+  const size_t start = LastLineStart(text);
+  std::string_view line = text.substr(start);
+  if (!line.starts_with(kChecksumPrefix)) return false;
+  line.remove_prefix(kChecksumPrefix.size());
+  if (line.ends_with('\n')) line.remove_suffix(1);
+  const std::string actual = Crc32Hex(text.substr(0, start));
+  PDVO_THROW_CHECK(line == actual, FormatError,
+                   where << ": checksum mismatch (the file is corrupt or was edited: its content gives crc32 " << actual
+                         << ", its last line says " << line << ")");
+  return true;
+}
 
 cv::Mat ToMat(const Eigen::MatrixXd& m) {
   cv::Mat out;
@@ -104,6 +143,86 @@ Learned ReadLearned(const cv::FileNode& node, const std::string& where, int dims
                        std::isfinite(f.platt_b),
                    FormatError, where << ": malformed " << OptionName(kind) << " model (sizes do not agree)");
   return f;
+}
+
+// PlaneModel::FromYaml without its translation of OpenCV errors.
+PlaneModel ParseModel(const std::string& text, const std::string& where) {
+  const bool checked = VerifyChecksum(text, where);
+  CheckYamlText(text, where);
+  cv::FileStorage fs;
+  try {
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception&) {
+    PDVO_THROW(FormatError, where << ": not a readable model (truncated or corrupt YAML)");
+  } catch (const std::length_error&) {  // OpenCV's parser on some malformed keys (found by fuzzing)
+    PDVO_THROW(FormatError, where << ": not a readable model (truncated or corrupt YAML)");
+  }
+  PDVO_THROW_CHECK(fs.isOpened() && fs.root().isMap(), FormatError, where << ": not a readable model");
+  PDVO_THROW_CHECK(static_cast<std::string>(fs["format"]) == kModelFormat, FormatError,
+                   where << ": not a " << kModelFormat << " file");
+  const int version = static_cast<int>(fs["version"]);
+  PDVO_THROW_CHECK(version == kModelVersion || version == 3, FormatError,
+                   where << ": model version " << version << ", this build reads versions 3 and " << kModelVersion
+                         << " (retrain with pdvo train)");
+  PDVO_THROW_CHECK(checked || version < 5, FormatError,
+                   where << ": no checksum line (a version " << version << " model ends with '" << kChecksumPrefix
+                         << "...'): the file was cut short or edited");
+  if (!checked) {
+    PDVO_LOG(Warning) << where << ": a version " << version
+                      << " model has no checksum, so its integrity cannot be checked (pdvo train writes version "
+                      << kModelVersion << ")";
+  }
+  LearnerKind learner = LearnerKind::kRvm;  // version 3: RVMs
+  if (version >= 4) {
+    const std::string name = static_cast<std::string>(fs["learner"]);
+    bool known = false;
+    for (const auto& [kind, kind_name] : OptionNames(LearnerKind{})) {
+      if (name == kind_name) learner = kind, known = true;
+    }
+    PDVO_THROW_CHECK(known, FormatError, where << ": unknown learner '" << name << "'");
+  }
+  PDVO_THROW_CHECK(static_cast<std::string>(fs[kEndMarker]) == kModelFormat, FormatError,
+                   where << ": truncated model (no end marker)");
+  PlaneModel m;
+  ReadOptions(fs["options"], m.options, where + ": options");
+  CheckOptionsOrThrow(m.options, where + ": options");
+  const cv::FileNode card = fs["card"];
+  PDVO_THROW_CHECK(card.isMap(), FormatError, where << ": missing card");
+  m.card.data = static_cast<std::string>(card["data"]);
+  m.card.images = static_cast<int>(card["images"]);
+  m.card.plane_regions = static_cast<int>(card["plane_regions"]);
+  m.card.non_plane_regions = static_cast<int>(card["non_plane_regions"]);
+  m.card.normal_regions = static_cast<int>(card["normal_regions"]);
+  m.card.folds = static_cast<int>(card["folds"]);
+  m.card.cv_accuracy = static_cast<double>(card["cv_accuracy"]);
+  m.card.cv_normal_error = static_cast<double>(card["cv_normal_error_deg"]);
+  m.card.seed = static_cast<int>(card["seed"]);
+  m.card.training_options = static_cast<std::string>(card["training_options"]);
+  m.card.pdvo_version = static_cast<std::string>(card["pdvo_version"]);
+  m.card.git_commit = static_cast<std::string>(card["git_commit"]);
+  m.gradient_words = Vocabulary::Read(fs["gradient_words"], where + ": gradient_words");
+  m.colour_words = Vocabulary::Read(fs["colour_words"], where + ": colour_words");
+  PDVO_THROW_CHECK(m.gradient_words.dims() == kGradientDims && m.colour_words.dims() == kColourDims, FormatError,
+                   where << ": vocabularies of the wrong descriptor size");
+  m.topics = ReadMatrix(fs.root(), where, "topics");
+  PDVO_THROW_CHECK(m.topics.rows() == m.gradient_words.size() + m.colour_words.size() && (m.topics.array() >= 0).all(),
+                   FormatError, where << ": the topic basis does not match the vocabularies");
+  m.feature_mean = ReadMatrix(fs.root(), where, "feature_mean");
+  m.feature_scale = ReadMatrix(fs.root(), where, "feature_scale");
+  const int dims = static_cast<int>(m.feature_mean.rows());
+  PDVO_THROW_CHECK(m.feature_mean.cols() == 1 && m.feature_scale.rows() == dims && m.feature_scale.cols() == 1 &&
+                       (m.feature_scale.array() > 0).all(),
+                   FormatError, where << ": malformed feature standardisation");
+  const cv::FileNode classifiers = fs["classifiers"];
+  PDVO_THROW_CHECK(classifiers.isSeq() && classifiers.size() > 0, FormatError, where << ": no classifiers");
+  for (size_t i = 0; i < classifiers.size(); ++i) {
+    const std::string what = where + ": classifier " + std::to_string(i);
+    m.classifiers.push_back(ReadLearned(classifiers[static_cast<int>(i)], what, dims, learner, true));
+  }
+  m.normal[0] = ReadLearned(fs["normal_x"], where + ": normal_x", dims, learner, false);
+  m.normal[1] = ReadLearned(fs["normal_y"], where + ": normal_y", dims, learner, false);
+  m.normal[2] = ReadLearned(fs["normal_z"], where + ": normal_z", dims, learner, false);
+  return m;
 }
 
 }  // namespace
@@ -213,79 +332,22 @@ std::string PlaneModel::ToYaml() const {
   WriteLearned(fs, "normal_y", normal[1]);
   WriteLearned(fs, "normal_z", normal[2]);
   fs << kEndMarker << kModelFormat;
-  return fs.releaseAndGetString();
+  return SealModelText(fs.releaseAndGetString());
 }
 
 PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& where) {
-  CheckYamlText(text, where);
-  cv::FileStorage fs;
-  try {
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    PDVO_THROW(FormatError, where << ": not a readable model (truncated or corrupt YAML)");
-  }
-  PDVO_THROW_CHECK(fs.isOpened() && fs.root().isMap(), FormatError, where << ": not a readable model");
-  PDVO_THROW_CHECK(static_cast<std::string>(fs["format"]) == kModelFormat, FormatError,
-                   where << ": not a " << kModelFormat << " file");
-  const int version = static_cast<int>(fs["version"]);
-  PDVO_THROW_CHECK(version == kModelVersion || version == 3, FormatError,
-                   where << ": model version " << version << ", this build reads versions 3 and " << kModelVersion
-                         << " (retrain with pdvo train)");
-  LearnerKind learner = LearnerKind::kRvm;  // version 3: RVMs
-  if (version >= 4) {
-    const std::string name = static_cast<std::string>(fs["learner"]);
-    bool known = false;
-    for (const auto& [kind, kind_name] : OptionNames(LearnerKind{})) {
-      if (name == kind_name) learner = kind, known = true;
-    }
-    PDVO_THROW_CHECK(known, FormatError, where << ": unknown learner '" << name << "'");
-  }
-  PDVO_THROW_CHECK(static_cast<std::string>(fs[kEndMarker]) == kModelFormat, FormatError,
-                   where << ": truncated model (no end marker)");
-  PlaneModel m;
-  ReadOptions(fs["options"], m.options, where + ": options");
-  CheckOptionsOrThrow(m.options, where + ": options");
-  const cv::FileNode card = fs["card"];
-  PDVO_THROW_CHECK(card.isMap(), FormatError, where << ": missing card");
-  m.card.data = static_cast<std::string>(card["data"]);
-  m.card.images = static_cast<int>(card["images"]);
-  m.card.plane_regions = static_cast<int>(card["plane_regions"]);
-  m.card.non_plane_regions = static_cast<int>(card["non_plane_regions"]);
-  m.card.normal_regions = static_cast<int>(card["normal_regions"]);
-  m.card.folds = static_cast<int>(card["folds"]);
-  m.card.cv_accuracy = static_cast<double>(card["cv_accuracy"]);
-  m.card.cv_normal_error = static_cast<double>(card["cv_normal_error_deg"]);
-  m.card.seed = static_cast<int>(card["seed"]);
-  m.card.training_options = static_cast<std::string>(card["training_options"]);
-  m.card.pdvo_version = static_cast<std::string>(card["pdvo_version"]);
-  m.card.git_commit = static_cast<std::string>(card["git_commit"]);
-  m.gradient_words = Vocabulary::Read(fs["gradient_words"], where + ": gradient_words");
-  m.colour_words = Vocabulary::Read(fs["colour_words"], where + ": colour_words");
-  PDVO_THROW_CHECK(m.gradient_words.dims() == kGradientDims && m.colour_words.dims() == kColourDims, FormatError,
-                   where << ": vocabularies of the wrong descriptor size");
-  m.topics = ReadMatrix(fs.root(), where, "topics");
-  PDVO_THROW_CHECK(m.topics.rows() == m.gradient_words.size() + m.colour_words.size() && (m.topics.array() >= 0).all(),
-                   FormatError, where << ": the topic basis does not match the vocabularies");
-  m.feature_mean = ReadMatrix(fs.root(), where, "feature_mean");
-  m.feature_scale = ReadMatrix(fs.root(), where, "feature_scale");
-  const int dims = static_cast<int>(m.feature_mean.rows());
-  PDVO_THROW_CHECK(m.feature_mean.cols() == 1 && m.feature_scale.rows() == dims && m.feature_scale.cols() == 1 &&
-                       (m.feature_scale.array() > 0).all(),
-                   FormatError, where << ": malformed feature standardisation");
-  const cv::FileNode classifiers = fs["classifiers"];
-  PDVO_THROW_CHECK(classifiers.isSeq() && classifiers.size() > 0, FormatError, where << ": no classifiers");
-  for (size_t i = 0; i < classifiers.size(); ++i) {
-    const std::string what = where + ": classifier " + std::to_string(i);
-    m.classifiers.push_back(ReadLearned(classifiers[static_cast<int>(i)], what, dims, learner, true));
-  }
-  m.normal[0] = ReadLearned(fs["normal_x"], where + ": normal_x", dims, learner, false);
-  m.normal[1] = ReadLearned(fs["normal_y"], where + ": normal_y", dims, learner, false);
-  m.normal[2] = ReadLearned(fs["normal_z"], where + ": normal_z", dims, learner, false);
-  return m;
+  return WithOpenCvErrorsNamed(where, [&] { return ParseModel(text, where); });
 }
 
 void PlaneModel::Write(const std::string& path) const { WriteFileAtomically(path, ToYaml()); }
 
 PlaneModel PlaneModel::Read(const std::string& path) { return FromYaml(ReadFile(path), path); }
+
+std::string SealModelText(std::string text) {
+  if (text.substr(LastLineStart(text)).starts_with(kChecksumPrefix)) text.resize(LastLineStart(text));
+  if (!text.empty() && text.back() != '\n') text += '\n';
+  const std::string crc = Crc32Hex(text);
+  return text.append(kChecksumPrefix).append(crc).append("\n");
+}
 
 }  // namespace pdvo

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 // GCC 12 reports edge iterators inside Boost.Graph's max-flow as maybe uninitialized (a false positive of its
-// inlining); this file holds no other code that the warning would guard.
+// inlining); this file holds no other code that the warning would guard. Clang has no such warning.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/boykov_kolmogorov_max_flow.hpp>
 #include <cmath>

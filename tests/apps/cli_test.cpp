@@ -238,9 +238,21 @@ TEST(Cli, VoRunsOnASynthStreetAndRefusesBadInput) {
   const nlohmann::json stats = nlohmann::json::parse(ReadFile(dir / "out/stats.json"));
   EXPECT_EQ(stats["totals"]["frames"], 20);
   EXPECT_EQ(stats["frames"].size(), 20u);
+  EXPECT_GT(stats["frames"][19]["resident_mib"].get<double>(), 1.0);
+  EXPECT_FALSE(fs::exists(dir / "out/stats.json.detections"));  // written as it went, then gathered in
   EXPECT_TRUE(fs::exists(dir / "out/vo.yaml"));
   EXPECT_EQ(ReadFile(dir / "out/map.ply").rfind("ply\n", 0), 0u);
   EXPECT_GT(fs::file_size(dir / "out/overlay.avi"), 1000u);
+
+  // Ground truth and depth maps, which the odometry does not use, are not read: broken ones change nothing.
+  const std::string groundtruth = ReadFile(dir / "s/groundtruth.txt");
+  WriteFileAtomically(dir / "s/groundtruth.txt", "not a trajectory\n");
+  WriteFileAtomically(dir / "s/depth/000003.png", "not a png");
+  const CommandResult unread =
+      Pdvo("vo -s " + (dir / "s") + " -o " + (dir / "unread") + " --mode idpp -v warning", dir);
+  ASSERT_EQ(unread.code, 0) << unread.err;
+  EXPECT_EQ(ReadFile(dir / "unread/trajectory.txt"), ReadFile(dir / "out/trajectory.txt"));
+  WriteFileAtomically(dir / "s/groundtruth.txt", groundtruth);  // pdvo report reads it
 
   const auto expect_error = [&](const std::string& args, const std::string& text) { ExpectError(args, text, dir); };
   expect_error("vo -v warning -s " + (dir / "s") + " -c " + (dir / "gone.yaml") + " -o " + (dir / "o1"), "gone.yaml");

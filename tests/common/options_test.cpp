@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pdvo/common/camera.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/test/support.h"
@@ -113,8 +114,8 @@ TEST(Options, CheckRejectsBadValues) {
   WriteFileAtomically(dir / "o.yaml", "%YAML:1.0\ninner:\n  iterations: 0\n");
   try {
     LoadOptions<OuterOptions>(dir / "o.yaml");
-    FAIL() << "expected InvalidArgument";
-  } catch (const InvalidArgument& e) {
+    FAIL() << "expected FormatError";
+  } catch (const FormatError& e) {  // the file's fault: a data error (exit 2)
     // One message naming the file and the innermost condition that failed, not the outer check of `inner`.
     EXPECT_EQ(std::string(e.what()),
               "invalid options in " + (dir / "o.yaml") + ": iterations > 0 does not hold (inner.iterations = 0)");
@@ -172,6 +173,11 @@ TEST(Options, YamlThatWouldHangOrCrashOpenCvIsRefused) {
             where + ": not valid YAML (line 3: did not find expected <document start>)");
   EXPECT_EQ(message_of("%YAML:1.0\nouter: " + std::string(33000, '[') + std::string(33000, ']') + "\n"),
             where + ": YAML nested deeper than 64 levels");
+  // A map to libyaml ("-U..." is a key), a list to OpenCV (fuzzer; OpenCV asserted on the first key lookup).
+  EXPECT_EQ(message_of("%YAML:1.0\n-Utrinsics as pufx : ol\n"),
+            where + ": not a YAML map of keys (as OpenCV reads it)");
+  WriteFileAtomically(dir / "c.yaml", "%YAML:1.0\n-Utrinsics as pufx : ol\n");
+  EXPECT_THROW(Camera::Read(dir / "c.yaml"), FormatError);
   // Cut short: refused at the end of the input.
   EXPECT_EQ(message_of("%YAML:1.0\nouter: {scale: [1").rfind(where + ": not valid YAML (line ", 0), 0u);
   // OpenCV's own header, with and without the document start, and a plain YAML file are taken.

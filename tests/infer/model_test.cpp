@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "pdvo/common/errors.h"
@@ -164,6 +165,7 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   const std::string version = "version: " + std::to_string(kModelVersion);
   ASSERT_NE(other.find(version), std::string::npos);
   other.replace(other.find(version), version.size(), "version: 7");
+  other = SealModelText(other);
   EXPECT_NE(message_of(other).find("model version 7, this build reads versions 3 and " + std::to_string(kModelVersion)),
             std::string::npos)
       << message_of(other);
@@ -171,9 +173,11 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   std::string three = text;
   three.replace(three.find(version), version.size(), "version: 3");
   three.replace(three.find("learner: rvm\n"), 13, "");
+  three.resize(three.rfind("# crc32: "));  // version 3 had no checksum
   EXPECT_EQ(PlaneModel::FromYaml(three, "m.yml").ToYaml(), text);
   std::string unknown = text;
   unknown.replace(unknown.find("learner: rvm"), 12, "learner: svr");
+  unknown = SealModelText(unknown);
   EXPECT_NE(message_of(unknown).find("m.yml: unknown learner 'svr'"), std::string::npos) << message_of(unknown);
   // Cut at a line boundary (valid YAML, no end marker) and in the middle of a matrix.
   const std::string at_line = text.substr(0, text.rfind('\n', text.size() / 2) + 1);
@@ -186,6 +190,59 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   PlaneModel none = RandomModel();
   none.classifiers.clear();
   EXPECT_NE(message_of(none.ToYaml()).find("m.yml: no classifiers"), std::string::npos) << message_of(none.ToYaml());
+}
+
+// CRC-32 bit by bit (the reflected polynomial 0xEDB88320), the reference for zlib's table-driven one.
+uint32_t BitwiseCrc32(const std::string& bytes) {
+  uint32_t crc = 0xffffffffu;
+  for (const unsigned char c : bytes) {
+    crc ^= c;
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+TEST(Model, ChecksumIsTheCrc32OfTheContentAndFindsEveryFlippedBit) {
+  char expected[32];
+  std::snprintf(expected, sizeof expected, "# crc32: %08x\n", BitwiseCrc32("123456789\n"));
+  EXPECT_EQ(SealModelText("123456789"), std::string("123456789\n") + expected);
+  EXPECT_EQ(BitwiseCrc32("123456789"), 0xcbf43926u);  // the standard check value
+  const std::string text = RandomModel().ToYaml();
+  EXPECT_EQ(SealModelText(text), text);  // sealing again changes nothing
+  EXPECT_EQ(PlaneModel::FromYaml(text, "m.yml").ToYaml(), text);
+  // A flipped bit anywhere (in the content, the version, the checksum line) is refused, naming the file.
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string flipped = text;
+    const size_t at = trial < 40 ? text.size() - 1 - trial : random() % text.size();  // the last line, then anywhere
+    flipped[at] = static_cast<char>(flipped[at] ^ (1 << (random() % 8)));
+    try {
+      PlaneModel::FromYaml(flipped, "m.yml");
+      ADD_FAILURE() << "a flipped bit at byte " << at << " of " << text.size() << " was accepted";
+    } catch (const FormatError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("m.yml: ", 0), 0u) << e.what();
+    }
+  }
+  // A matrix whose data does not match its declared size (fuzzer): OpenCV's assertion becomes the file's error.
+  std::string resized = text;
+  const std::string rows = "feature_scale: !!opencv-matrix\n   rows: ";
+  ASSERT_NE(resized.find(rows), std::string::npos);
+  resized.insert(resized.find(rows) + rows.size(), "1");
+  try {
+    PlaneModel::FromYaml(SealModelText(resized), "m.yml");
+    ADD_FAILURE() << "a matrix of the wrong size was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("m.yml: malformed (OpenCV: ", 0), 0u) << e.what();
+  }
+  // An edit whose checksum was not renewed.
+  std::string edited = text;
+  edited.replace(edited.find("min_points: "), 12, "min_points: 1");
+  try {
+    PlaneModel::FromYaml(edited, "m.yml");
+    ADD_FAILURE() << "an edited model was accepted";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.yml: checksum mismatch"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -37,6 +37,8 @@ struct SequenceOptions {
   double fps = 30.0;                 // image folders without times, and videos without time stamps
   std::string times_path;            // image folder: optional file of one time per line
   bool load_depth = true;            // TUM: read depth maps
+  bool load_groundtruth = true;      // TUM groundtruth.txt, KITTI poses.txt: read (a command that does not use
+                                     // them leaves them unread, so that a bad one does not stop it)
 };
 
 class Sequence {

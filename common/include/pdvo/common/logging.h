@@ -20,6 +20,9 @@ LogLevel GetLogLevel();
 // Parses "error", "warning", "info", "debug" or 0..3; throws InvalidArgument otherwise.
 LogLevel ParseLogLevel(const std::string& text);
 
+// The process's resident memory now, in MiB (from /proc/self/statm; 0 where there is none).
+double ResidentMiB();
+
 namespace detail {
 // Collects one message and writes it, whole, to stderr when destroyed.
 class LogMessage {

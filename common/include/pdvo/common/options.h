@@ -199,6 +199,17 @@ inline constexpr int kMaxYamlDepth = 64;
 inline constexpr size_t kMaxYamlBytes = size_t{256} << 20;
 void CheckYamlText(const std::string& text, const std::string& where);
 
+// Returns read() (code that reads a cv::FileStorage), with an OpenCV error turned into a FormatError naming
+// `where`: OpenCV asserts on some malformed values, e.g. a matrix whose data does not match its size.
+template <class Read>
+auto WithOpenCvErrorsNamed(const std::string& where, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const cv::Exception& e) {
+    PDVO_THROW(FormatError, where << ": malformed (OpenCV: " << e.err << ")");
+  }
+}
+
 // Opens a YAML file for reading after CheckYamlText; throws IoError or FormatError naming the file if it cannot be
 // read or is not such YAML.
 cv::FileStorage OpenYamlForReading(const std::string& path);
@@ -273,13 +284,20 @@ void CheckOptionsOrThrow(const T& options, const std::string& what) {
              "invalid " << what << ": " << condition << " does not hold" << listed << (listed.empty() ? "" : ")"));
 }
 
-// Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them.
+// Reads options from the map `section` of a YAML file (the root map if section is empty) and checks them; throws
+// FormatError naming the file for values that fail the check.
 template <OptionsStruct T>
 T LoadOptions(const std::string& path, const std::string& section = "") {
   cv::FileStorage fs = OpenYamlForReading(path);
   T options;
-  ReadOptions(section.empty() ? fs.root() : fs[section], options, section.empty() ? path : path + ": " + section);
-  CheckOptionsOrThrow(options, "options in " + path);
+  WithOpenCvErrorsNamed(path, [&] {
+    ReadOptions(section.empty() ? fs.root() : fs[section], options, section.empty() ? path : path + ": " + section);
+  });
+  try {
+    CheckOptionsOrThrow(options, "options in " + path);
+  } catch (const InvalidArgument& e) {  // a file's fault: a data error
+    PDVO_THROW(FormatError, e.what());
+  }
   return options;
 }
 

@@ -20,7 +20,7 @@
 namespace pdvo {
 
 inline constexpr const char* kModelFormat = "pdvo-plane-model";
-inline constexpr int kModelVersion = 4;
+inline constexpr int kModelVersion = 5;  // 5: ends with a checksum line (see SealModelText)
 
 // A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
 struct RvmFunction {
@@ -116,11 +116,17 @@ struct PlaneModel {
   LearnerKind learner() const { return classifiers.empty() ? LearnerKind::kRvm : classifiers.front().kind; }
   ModelCard card;
 
-  std::string ToYaml() const;
-  // Throws FormatError naming `where` for another format, another version, a truncated or malformed file.
+  std::string ToYaml() const;  // sealed (SealModelText)
+  // Throws FormatError naming `where` for another format, another version, a truncated or malformed file, or one
+  // whose checksum does not match its content. Versions 3 and 4 (no checksum) are read with a warning.
   static PlaneModel FromYaml(const std::string& text, const std::string& where);
   void Write(const std::string& path) const;  // atomically
   static PlaneModel Read(const std::string& path);
 };
+
+// A model file's last line is "# crc32: XXXXXXXX", the CRC-32 (zlib's) of every byte before it, so that a flipped
+// bit or an edit is found on reading. SealModelText returns `text` with that line replaced or added: for tools
+// and tests that edit a model on purpose.
+std::string SealModelText(std::string text);
 
 }  // namespace pdvo
