@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -221,6 +222,8 @@ class VideoSequence : public Sequence {
   VideoSequence(const std::string& path, double fps) : path_(path) {
     // FFmpeg decodes video files; other backends (GStreamer, image sequences) print noise for files they
     // cannot open.
+    // FFmpeg's own messages on a damaged stream would add lines to the one-line error (unless the user asks).
+    setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
     capture_.open(path, cv::CAP_FFMPEG);
     PDVO_THROW_CHECK(capture_.isOpened(), IoError, path << ": cannot open as a video");
     const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
@@ -232,6 +235,11 @@ class VideoSequence : public Sequence {
     cv::Mat image;
     if (!capture_.read(image) || image.empty()) {
       PDVO_THROW_CHECK(next_ > 0, FormatError, path_ << ": video holds no frames");
+      // The container's count may be an estimate (duration times rate) for some formats: a frame or 1% short is
+      // taken; more is a video cut short or corrupt, which would otherwise pass as a shorter one.
+      PDVO_THROW_CHECK(next_ + std::max<size_t>(1, count_ / 100) >= count_, FormatError,
+                       path_ << ": the video ends after " << next_ << " of the " << count_
+                             << " frames its container lists (truncated or corrupt)");
       return false;
     }
     if (image.channels() == 1) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);

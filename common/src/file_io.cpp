@@ -1,5 +1,7 @@
 #include "pdvo/common/file_io.h"
 
+#include <zlib.h>
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/syscall.h>
@@ -139,16 +141,29 @@ std::vector<std::pair<int, std::string>> ReadDataLines(const std::string& path) 
 }
 
 namespace {
-// A truncated PNG or JPEG is caught here, before the decoder, because libpng and libjpeg report it on stderr
-// themselves. A PNG ends with its IEND chunk, a JPEG with its end-of-image marker (possibly followed by a
-// little padding).
-void CheckNotTruncated(const std::string& path, const std::string& bytes) {
+// A truncated PNG or JPEG, or a PNG with a damaged chunk, is caught here, before the decoder, because libpng and
+// libjpeg report such files on stderr themselves. A PNG is a chain of chunks, each with a CRC-32 of its type and
+// data, up to IEND; a JPEG ends with its end-of-image marker (possibly followed by a little padding).
+void CheckImageIntact(const std::string& path, const std::string& bytes) {
   static const std::string kPngSignature = "\x89PNG\r\n\x1a\n";
-  const std::string tail = bytes.substr(bytes.size() > 64 ? bytes.size() - 64 : 0);
   if (bytes.compare(0, kPngSignature.size(), kPngSignature) == 0) {
-    PDVO_THROW_CHECK(tail.find("IEND") != std::string::npos, IoError,
-                     path << ": cannot decode image (truncated PNG: no IEND chunk)");
+    const auto be32 = [&](size_t at) {
+      const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + at);
+      return uint32_t{b[0]} << 24 | uint32_t{b[1]} << 16 | uint32_t{b[2]} << 8 | uint32_t{b[3]};
+    };
+    for (size_t at = kPngSignature.size();;) {
+      PDVO_THROW_CHECK(at + 12 <= bytes.size() && be32(at) <= bytes.size() - at - 12, IoError,
+                       path << ": cannot decode image (truncated PNG: no IEND chunk)");
+      const uint32_t length = be32(at);
+      const std::string type = bytes.substr(at + 4, 4);
+      const uLong crc = crc32(0L, reinterpret_cast<const Bytef*>(bytes.data() + at + 4), length + 4);
+      PDVO_THROW_CHECK(crc == be32(at + 8 + length), IoError,
+                       path << ": cannot decode image (corrupt PNG: its " << type << " chunk fails its CRC)");
+      if (type == "IEND") break;
+      at += 12 + length;
+    }
   } else if (bytes.size() > 2 && static_cast<uint8_t>(bytes[0]) == 0xFF && static_cast<uint8_t>(bytes[1]) == 0xD8) {
+    const std::string tail = bytes.substr(bytes.size() > 64 ? bytes.size() - 64 : 0);
     PDVO_THROW_CHECK(tail.find("\xFF\xD9") != std::string::npos, IoError,
                      path << ": cannot decode image (truncated JPEG: no end-of-image marker)");
   }
@@ -158,7 +173,7 @@ void CheckNotTruncated(const std::string& path, const std::string& bytes) {
 cv::Mat ReadImage(const std::string& path, int flags) {
   const std::string bytes = ReadFile(path);
   PDVO_THROW_CHECK(!bytes.empty(), IoError, path << ": image file is empty");
-  CheckNotTruncated(path, bytes);
+  CheckImageIntact(path, bytes);
   cv::Mat image;
   try {
     image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), flags);

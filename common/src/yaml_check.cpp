@@ -2,7 +2,11 @@
 // which keeps its own stack and so neither recurses nor hangs.
 #include <yaml.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <memory>
 #include <regex>
 #include <string_view>
@@ -43,6 +47,48 @@ bool IsOpenCvBase64(std::string_view value) {
   return std::regex_match(header, kHeader);
 }
 
+// The number of elements an OpenCV matrix map (!!opencv-matrix: rows, cols; !!opencv-nd-matrix: sizes) declares,
+// followed through the parser's events: OpenCV allocates a matrix of that size before it reads the data, so a
+// matrix larger than its file could hold is refused first (fuzzing declared 10^11 elements in a 24 KB file).
+struct MatrixSize {
+  int depth = -1;                                          // the depth of the matrix map's keys; -1: not in one
+  bool key_next = true, in_sizes = false, closed = false;  // closed: by the event taken last
+  size_t line = 0;                                         // where the matrix starts
+  std::string key;
+  double elements = 0;  // of the matrix read last or being read
+
+  // One event, at `depth` (before the event changes it).
+  void Take(yaml_event_type_t type, const std::string& tag, const std::string& value, int at, size_t at_line) {
+    closed = false;
+    const auto factor = [&] {  // a size must be a whole number (OpenCV reads "~" as a huge one)
+      char* end = nullptr;
+      const double v = std::strtod(value.c_str(), &end);
+      const bool whole = !value.empty() && end && *end == '\0' && v >= 0 && v == std::floor(v);
+      return whole ? std::max(1.0, v) : std::numeric_limits<double>::infinity();
+    };
+    if (depth < 0) {
+      if (type == YAML_MAPPING_START_EVENT && tag.rfind("tag:yaml.org,2002:opencv-", 0) == 0) {
+        *this = MatrixSize();
+        depth = at + 1, elements = 1, line = at_line;
+      }
+      return;
+    }
+    if (at == depth) {
+      if (type == YAML_MAPPING_END_EVENT) {
+        depth = -1, closed = true;
+      } else if (type == YAML_SCALAR_EVENT && key_next) {
+        key = value, key_next = false;
+      } else {  // a value
+        if (type == YAML_SCALAR_EVENT && (key == "rows" || key == "cols")) elements *= factor();
+        in_sizes = type == YAML_SEQUENCE_START_EVENT && key == "sizes";
+        key_next = true;
+      }
+    } else if (in_sizes && at == depth + 1 && type == YAML_SCALAR_EVENT) {
+      elements *= factor();
+    }
+  }
+};
+
 }  // namespace
 
 void CheckYamlText(const std::string& text, const std::string& where) {
@@ -58,23 +104,35 @@ void CheckYamlText(const std::string& text, const std::string& where) {
   yaml_parser_set_input_string(&parser, reinterpret_cast<const unsigned char*>(body.data()), body.size());
   int depth = 0;
   bool top = true;  // the next node is the document's top level
+  MatrixSize matrix;
   for (;;) {
     yaml_event_t event;
     PDVO_THROW_CHECK(yaml_parser_parse(&parser, &event), FormatError,
                      where << ": not valid YAML (line " << parser.problem_mark.line + 1 << ": "
                            << (parser.problem ? parser.problem : "unreadable") << ")");
     const yaml_event_type_t type = event.type;
-    const bool binary =
-        type == YAML_SCALAR_EVENT && event.data.scalar.tag &&
-        std::string_view(reinterpret_cast<const char*>(event.data.scalar.tag)) == "tag:yaml.org,2002:binary";
-    const bool readable =
-        !binary || IsOpenCvBase64(std::string_view(reinterpret_cast<const char*>(event.data.scalar.value),
-                                                   event.data.scalar.length));
+    const auto text_of = [](const yaml_char_t* chars) {
+      return chars ? std::string(reinterpret_cast<const char*>(chars)) : std::string();
+    };
+    const std::string tag = type == YAML_SCALAR_EVENT          ? text_of(event.data.scalar.tag)
+                            : type == YAML_MAPPING_START_EVENT ? text_of(event.data.mapping_start.tag)
+                                                               : std::string();
+    const std::string value =
+        type == YAML_SCALAR_EVENT
+            ? std::string(reinterpret_cast<const char*>(event.data.scalar.value), event.data.scalar.length)
+            : std::string();
     const size_t line = event.start_mark.line + 1;
     yaml_event_delete(&event);
     PDVO_THROW_CHECK(
-        readable, FormatError,
+        tag != "tag:yaml.org,2002:binary" || IsOpenCvBase64(value), FormatError,
         where << ": line " << line << ": binary data that is not an OpenCV matrix's (base64 with its type)");
+    matrix.Take(type, tag, value, depth, line);
+    PDVO_THROW_CHECK(!matrix.closed || matrix.elements <= static_cast<double>(text.size()), FormatError,
+                     where << ": line " << matrix.line << ": a matrix of "
+                           << (std::isinf(matrix.elements) ? std::string("a size that is not a whole number")
+                                                           : std::to_string(static_cast<long long>(matrix.elements)) +
+                                                                 " elements, more than the file's " +
+                                                                 std::to_string(text.size()) + " bytes could hold"));
     if (type == YAML_STREAM_END_EVENT) break;
     if (top && (type == YAML_SCALAR_EVENT || type == YAML_SEQUENCE_START_EVENT || type == YAML_ALIAS_EVENT)) {
       PDVO_THROW(FormatError, where << ": not a YAML map of keys at the top");

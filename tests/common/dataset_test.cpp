@@ -38,6 +38,19 @@ TEST(FileIo, TruncatedPngIsAnIoErrorNamingTheFile) {
     EXPECT_NE(std::string(e.what()).find("cut.png: cannot decode image"), std::string::npos) << e.what();
   }
   EXPECT_THROW(ReadImage(dir / "none.png", cv::IMREAD_COLOR), IoError);
+  // One flipped bit in the pixel data: refused before libpng sees it (which would print a line of its own).
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 4;
+  WriteFileAtomically(dir / "flipped.png", flipped);
+  try {
+    ReadImage(dir / "flipped.png", cv::IMREAD_COLOR);
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("flipped.png: cannot decode image (corrupt PNG: its IDAT chunk fails its CRC)"),
+        std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(FileIo, AtomicWriteLeavesNoTemporaryFile) {
@@ -262,6 +275,33 @@ TEST(Dataset, VideoFile) {
   EXPECT_EQ(n, 5);
   WriteFileAtomically(dir / "bad.avi", "garbage");
   EXPECT_THROW(OpenSequence(dir / "bad.avi"), IoError);
+}
+
+// A video cut short is an error naming it, not a shorter video; without its index at the end, all is read.
+TEST(Dataset, TruncatedVideoIsAnError) {
+  test::TempDir dir;
+  const std::string path = dir / "v.avi";
+  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, cv::Size(32, 24));
+  ASSERT_TRUE(writer.isOpened());
+  for (int i = 0; i < 40; ++i) writer << Pattern(6 * i);
+  writer.release();
+  const std::string whole = ReadFile(path);
+  const auto frames_read = [&](const std::string& bytes) {
+    WriteFileAtomically(dir / "cut.avi", bytes);
+    auto seq = OpenSequence(dir / "cut.avi");
+    Frame f;
+    int n = 0;
+    while (seq->Next(&f)) ++n;
+    return n;
+  };
+  EXPECT_EQ(frames_read(whole), 40);
+  try {
+    frames_read(whole.substr(0, whole.size() / 2));
+    ADD_FAILURE() << "half a video was read without an error";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.avi: the video ends after "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("of the 40 frames its container lists"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

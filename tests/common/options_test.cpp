@@ -178,6 +178,16 @@ TEST(Options, YamlThatWouldHangOrCrashOpenCvIsRefused) {
             where + ": not a YAML map of keys (as OpenCV reads it)");
   WriteFileAtomically(dir / "c.yaml", "%YAML:1.0\n-Utrinsics as pufx : ol\n");
   EXPECT_THROW(Camera::Read(dir / "c.yaml"), FormatError);
+  // A matrix larger than its file could hold, which OpenCV would allocate before reading its data (fuzzer).
+  EXPECT_EQ(message_of("%YAML:1.0\nm: !!opencv-matrix\n  rows: 100000\n  cols: 100000\n  dt: d\n  data: [1]\n")
+                .rfind(where + ": line 2: a matrix of 10000000000 elements, more than the file's", 0),
+            0u);
+  EXPECT_NE(message_of("%YAML:1.0\nm: !!opencv-nd-matrix\n  sizes: [3000, 3000, 3000]\n  dt: d\n  data: [1]\n")
+                .find("a matrix of 27000000000 elements"),
+            std::string::npos);
+  EXPECT_NE(message_of("%YAML:1.0\nm: !!opencv-matrix\n  rows: 2\n  cols: ~\n  dt: d\n  data: [1, 2]\n")
+                .find("line 2: a matrix of a size that is not a whole number"),
+            std::string::npos);
   // Cut short: refused at the end of the input.
   EXPECT_EQ(message_of("%YAML:1.0\nouter: {scale: [1").rfind(where + ": not valid YAML (line ", 0), 0u);
   // OpenCV's own header, with and without the document start, and a plain YAML file are taken.
