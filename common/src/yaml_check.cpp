@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <memory>
@@ -127,12 +128,15 @@ void CheckYamlText(const std::string& text, const std::string& where) {
         tag != "tag:yaml.org,2002:binary" || IsOpenCvBase64(value), FormatError,
         where << ": line " << line << ": binary data that is not an OpenCV matrix's (base64 with its type)");
     matrix.Take(type, tag, value, depth, line);
-    PDVO_THROW_CHECK(!matrix.closed || matrix.elements <= static_cast<double>(text.size()), FormatError,
-                     where << ": line " << matrix.line << ": a matrix of "
-                           << (std::isinf(matrix.elements) ? std::string("a size that is not a whole number")
-                                                           : std::to_string(static_cast<long long>(matrix.elements)) +
-                                                                 " elements, more than the file's " +
-                                                                 std::to_string(text.size()) + " bytes could hold"));
+    if (matrix.closed && !(matrix.elements <= static_cast<double>(text.size()))) {
+      char elements[32];
+      std::snprintf(elements, sizeof elements, "%.0f", matrix.elements);
+      PDVO_THROW(FormatError,
+                 where << ": line " << matrix.line << ": a matrix of "
+                       << (std::isinf(matrix.elements) ? std::string("a size that is not a whole number")
+                                                       : std::string(elements) + " elements, more than the file's " +
+                                                             std::to_string(text.size()) + " bytes could hold"));
+    }
     if (type == YAML_STREAM_END_EVENT) break;
     if (top && (type == YAML_SCALAR_EVENT || type == YAML_SEQUENCE_START_EVENT || type == YAML_ALIAS_EVENT)) {
       PDVO_THROW(FormatError, where << ": not a YAML map of keys at the top");
