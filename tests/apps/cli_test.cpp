@@ -395,7 +395,10 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
   const size_t fuse = text.find("fuse_normals: true");
   ASSERT_NE(fuse, std::string::npos);
   text.replace(fuse, 18, "fuse_normals: false");
-  WriteFileAtomically(dir / "unfused.yml", text);
+  WriteFileAtomically(dir / "unfused.yml", text);  // the edit without a new checksum is refused, naming the file
+  ExpectError("evaluate -m " + (dir / "unfused.yml") + " -a " + (dir / "test/annotations"),
+              "unfused.yml: checksum mismatch", dir);
+  WriteFileAtomically(dir / "unfused.yml", SealModelText(text));
   const CommandResult u = Pdvo("evaluate -m " + (dir / "unfused.yml") + " -a " + (dir / "test/annotations") +
                                    " --json " + (dir / "unfused.json") + " -v warning",
                                dir);
