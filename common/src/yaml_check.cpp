@@ -9,7 +9,6 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
-#include <regex>
 #include <string_view>
 
 #include "pdvo/common/errors.h"
@@ -41,11 +40,18 @@ bool IsOpenCvBase64(std::string_view value) {
   for (size_t i = 0; i < 32; i += 4) {
     const int v = Base64Value(digits[i]) << 18 | Base64Value(digits[i + 1]) << 12 | Base64Value(digits[i + 2]) << 6 |
                   Base64Value(digits[i + 3]);
-    header += static_cast<char>(v >> 16 & 255), header += static_cast<char>(v >> 8 & 255),
-        header += static_cast<char>(v & 255);
+    for (const int shift : {16, 8, 0}) header += static_cast<char>(v >> shift & 255);
   }
-  static const std::regex kHeader("([0-9]*[ucwsifdhr])+[ \\0]*");
-  return std::regex_match(header, kHeader);
+  // One or more of (an optional count, then a type letter), then padding: "1f", "3d", "iif".
+  constexpr std::string_view kTypes = "ucwsifdhr";
+  size_t at = 0, groups = 0;
+  while (at < header.size() && header[at] != ' ' && header[at] != '\0') {
+    while (at < header.size() && std::isdigit(static_cast<unsigned char>(header[at]))) ++at;
+    if (at == header.size() || kTypes.find(header[at]) == std::string_view::npos) return false;
+    ++at, ++groups;
+  }
+  while (at < header.size() && (header[at] == ' ' || header[at] == '\0')) ++at;
+  return groups > 0 && at == header.size();
 }
 
 // The number of elements an OpenCV matrix map (!!opencv-matrix: rows, cols; !!opencv-nd-matrix: sizes) declares,
