@@ -54,12 +54,4 @@ Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path
   return *sequence.camera();
 }
 
-void CheckSameImageSize(const Annotation& reference, const std::string& reference_path, const Annotation& estimate,
-                        const std::string& estimate_path) {
-  PDVO_THROW_CHECK(
-      estimate.image_width == reference.image_width && estimate.image_height == reference.image_height, FormatError,
-      estimate_path << ": the image is " << estimate.image_width << "x" << estimate.image_height << ", "
-                    << reference_path << " says " << reference.image_width << "x" << reference.image_height);
-}
-
 }  // namespace pdvo::apps

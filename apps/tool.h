@@ -56,10 +56,6 @@ Options LoadToolOptions(const std::string& config_path, const std::string& secti
 // the sequence that holds none.
 Camera SequenceCamera(const Sequence& sequence, const std::string& sequence_path, const std::string& camera_path);
 
-// Throws FormatError naming both files unless the two annotations are of images of one size.
-void CheckSameImageSize(const Annotation& reference, const std::string& reference_path, const Annotation& estimate,
-                        const std::string& estimate_path);
-
 // Every .json file among the given files and folders (folders not recursed), sorted; throws IoError for a
 // missing path and FormatError for a folder without annotations.
 std::vector<std::string> ListAnnotationFiles(const std::vector<std::string>& inputs);

@@ -203,6 +203,14 @@ std::string ResolveImagePath(const Annotation& annotation, const std::string& js
   return (folder / annotation.image_path).lexically_normal().string();
 }
 
+void CheckSameImageSize(const Annotation& reference, const std::string& reference_where, const Annotation& estimate,
+                        const std::string& estimate_where) {
+  PDVO_THROW_CHECK(
+      estimate.image_width == reference.image_width && estimate.image_height == reference.image_height, FormatError,
+      estimate_where << ": the image is " << estimate.image_width << "x" << estimate.image_height << ", "
+                     << reference_where << " says " << reference.image_width << "x" << reference.image_height);
+}
+
 bool PolygonSelfIntersects(const std::vector<Eigen::Vector2d>& polygon_in) {
   const std::vector<Eigen::Vector2d> polygon = Distinct(polygon_in);
   const size_t n = polygon.size();

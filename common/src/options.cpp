@@ -146,22 +146,25 @@ void ThrowIfUnknownKeys(const cv::FileNode& node, const std::set<std::string>& k
 }
 }  // namespace detail
 
-cv::FileStorage OpenYamlForReading(const std::string& path) {
-  CheckExists(path);
-  const std::string text = ReadFile(path);
-  CheckYamlText(text, path);
+cv::FileStorage OpenYamlText(const std::string& text, const std::string& where) {
+  CheckYamlText(text, where);
   cv::FileStorage fs;
   try {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
-    PDVO_THROW(FormatError, path << ": not valid YAML (" << e.err << ")");
+    PDVO_THROW(FormatError, where << ": not valid YAML (" << e.err << ")");
   } catch (const std::length_error& e) {  // OpenCV's parser on some malformed keys (found by fuzzing)
-    PDVO_THROW(FormatError, path << ": not valid YAML (OpenCV's parser failed: " << e.what() << ")");
+    PDVO_THROW(FormatError, where << ": not valid YAML (OpenCV's parser failed: " << e.what() << ")");
   }
-  PDVO_THROW_CHECK(fs.isOpened(), IoError, path << ": cannot open as YAML");
+  PDVO_THROW_CHECK(fs.isOpened(), FormatError, where << ": cannot open as YAML");
   // OpenCV's parser does not always read what libyaml reads (e.g. "-a : b" is a map to one, a list to the other).
-  PDVO_THROW_CHECK(fs.root().isMap(), FormatError, path << ": not a YAML map of keys (as OpenCV reads it)");
+  PDVO_THROW_CHECK(fs.root().isMap(), FormatError, where << ": not a YAML map of keys (as OpenCV reads it)");
   return fs;
+}
+
+cv::FileStorage OpenYamlForReading(const std::string& path) {
+  CheckExists(path);
+  return OpenYamlText(ReadFile(path), path);
 }
 
 }  // namespace pdvo

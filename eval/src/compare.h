@@ -9,7 +9,7 @@
 namespace pdvo::detail {
 
 // The size two annotations of one image are rasterised at to compare them: the reference's, at most `max_width`
-// wide. Throws InvalidArgument (naming `what`) if they are of different image sizes.
+// wide. Throws FormatError (naming `what`) if they are of different image sizes.
 cv::Size ComparisonSize(const Annotation& reference, const Annotation& estimate, int max_width, const char* what);
 
 // The median (the mean of the middle two of an even count); 0 for none.

@@ -155,10 +155,7 @@ double PlanePurity::Share(int min_points, long* points) const {
 namespace detail {
 
 cv::Size ComparisonSize(const Annotation& reference, const Annotation& estimate, int max_width, const char* what) {
-  PDVO_THROW_CHECK(reference.image_width == estimate.image_width && reference.image_height == estimate.image_height,
-                   InvalidArgument,
-                   what << ": the reference is " << reference.image_width << "x" << reference.image_height
-                        << " but the estimate is " << estimate.image_width << "x" << estimate.image_height);
+  CheckSameImageSize(reference, std::string(what) + ": the reference", estimate, std::string(what) + ": the estimate");
   const double scale = std::min(1.0, static_cast<double>(max_width) / reference.image_width);
   return {static_cast<int>(std::lround(reference.image_width * scale)),
           static_cast<int>(std::lround(reference.image_height * scale))};

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core/eigen.hpp>
-#include <stdexcept>
 #include <string_view>
 
 #include "pdvo/common/errors.h"
@@ -148,16 +147,7 @@ Learned ReadLearned(const cv::FileNode& node, const std::string& where, int dims
 // PlaneModel::FromYaml without its translation of OpenCV errors.
 PlaneModel ParseModel(const std::string& text, const std::string& where) {
   const bool checked = VerifyChecksum(text, where);
-  CheckYamlText(text, where);
-  cv::FileStorage fs;
-  try {
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception&) {
-    PDVO_THROW(FormatError, where << ": not a readable model (truncated or corrupt YAML)");
-  } catch (const std::length_error&) {  // OpenCV's parser on some malformed keys (found by fuzzing)
-    PDVO_THROW(FormatError, where << ": not a readable model (truncated or corrupt YAML)");
-  }
-  PDVO_THROW_CHECK(fs.isOpened() && fs.root().isMap(), FormatError, where << ": not a readable model");
+  cv::FileStorage fs = OpenYamlText(text, where);
   PDVO_THROW_CHECK(static_cast<std::string>(fs["format"]) == kModelFormat, FormatError,
                    where << ": not a " << kModelFormat << " file");
   const int version = static_cast<int>(fs["version"]);

@@ -23,6 +23,14 @@ cv::Mat Pattern(int value) {
   return m;
 }
 
+// An MJPG video at 10 Hz of `frames` patterns, the i-th Pattern(step * i); false if OpenCV cannot write one.
+bool WritePatternVideo(const std::string& path, int frames, int step) {
+  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, cv::Size(32, 24));
+  if (!writer.isOpened()) return false;
+  for (int i = 0; i < frames; ++i) writer << Pattern(step * i);
+  return true;
+}
+
 TEST(FileIo, TruncatedPngIsAnIoErrorNamingTheFile) {
   test::TempDir dir;
   cv::Mat noise(64, 64, CV_8UC3);
@@ -260,10 +268,7 @@ TEST(Dataset, KittiFolderReadsCalibTimesAndPoses) {
 TEST(Dataset, VideoFile) {
   test::TempDir dir;
   const std::string path = dir / "v.avi";
-  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, cv::Size(32, 24));
-  ASSERT_TRUE(writer.isOpened());
-  for (int i = 0; i < 5; ++i) writer << Pattern(40 * i);
-  writer.release();
+  ASSERT_TRUE(WritePatternVideo(path, 5, 40));
   auto seq = OpenSequence(path);
   Frame f;
   int n = 0;
@@ -281,10 +286,7 @@ TEST(Dataset, VideoFile) {
 TEST(Dataset, TruncatedVideoIsAnError) {
   test::TempDir dir;
   const std::string path = dir / "v.avi";
-  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, cv::Size(32, 24));
-  ASSERT_TRUE(writer.isOpened());
-  for (int i = 0; i < 40; ++i) writer << Pattern(6 * i);
-  writer.release();
+  ASSERT_TRUE(WritePatternVideo(path, 40, 6));
   const std::string whole = ReadFile(path);
   const auto frames_read = [&](const std::string& bytes) {
     WriteFileAtomically(dir / "cut.avi", bytes);

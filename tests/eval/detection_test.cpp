@@ -73,7 +73,7 @@ TEST(DetectionScore, APlaneInTwoHalves) {
   EXPECT_NEAR(s.covering, 0.5, 0.01);
   Annotation other = Reference();
   other.image_width = 50;
-  EXPECT_THROW(ScoreDetection(Reference(), other), InvalidArgument);
+  EXPECT_THROW(ScoreDetection(Reference(), other), FormatError);
 }
 
 }  // namespace

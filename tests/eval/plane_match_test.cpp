@@ -51,7 +51,7 @@ TEST(PlaneMatch, OneToOneAndUnmatchedCountAsZero) {
   EXPECT_NEAR(s.median_matched_iou, 0.5, 1e-12);
   Annotation other = est;
   other.image_width = 300;
-  EXPECT_THROW(ComparePlanes(ref, other), InvalidArgument);
+  EXPECT_THROW(ComparePlanes(ref, other), FormatError);
 }
 
 TEST(PlanePurity, ShareOfPointsOnTheirPlanesMainLabel) {

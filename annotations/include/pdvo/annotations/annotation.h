@@ -55,6 +55,9 @@ void WriteAnnotation(const std::string& path, const Annotation& annotation);
 
 // The image file of an annotation read from `json_path`.
 std::string ResolveImagePath(const Annotation& annotation, const std::string& json_path);
+// Throws FormatError naming both sources unless the two annotations are of images of one size.
+void CheckSameImageSize(const Annotation& reference, const std::string& reference_where, const Annotation& estimate,
+                        const std::string& estimate_where);
 
 struct ValidationIssue {
   bool is_error = true;  // false: a warning

@@ -210,8 +210,10 @@ auto WithOpenCvErrorsNamed(const std::string& where, Read&& read) -> decltype(re
   }
 }
 
-// Opens a YAML file for reading after CheckYamlText; throws IoError or FormatError naming the file if it cannot be
-// read or is not such YAML.
+// Opens YAML text (read from `where`) after CheckYamlText has passed it; throws FormatError naming `where` if it is
+// not valid YAML or its top level is not a map of keys. The one way the project hands YAML to OpenCV.
+cv::FileStorage OpenYamlText(const std::string& text, const std::string& where);
+// OpenYamlText on a file's content; IoError naming the file if it cannot be read.
 cv::FileStorage OpenYamlForReading(const std::string& path);
 
 namespace detail {

@@ -41,7 +41,7 @@ struct DetectionScore {
   long segmentation_pixels = 0;  // the reference plane pixels the segmentation figures are over
 };
 
-// Throws InvalidArgument if the two annotations are of different image sizes.
+// Throws FormatError if the two annotations are of different image sizes.
 DetectionScore ScoreDetection(const Annotation& reference, const Annotation& detection,
                               const DetectionScoreOptions& options = {});
 

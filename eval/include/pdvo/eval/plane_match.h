@@ -32,7 +32,7 @@ struct PlaneMatchOptions {
   int max_width = 640;   // masks are compared at most this wide
 };
 
-// Throws InvalidArgument if the two annotations are of different image sizes.
+// Throws FormatError if the two annotations are of different image sizes.
 PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& estimate,
                               const PlaneMatchOptions& options = {});
 
