@@ -124,10 +124,12 @@ TEST_F(Report, ShowsTheNumbersOfTheRuns) {
       ASSERT_TRUE(cells.count({r, key}));
       const auto& [shown, text] = cells.at({r, key});
       EXPECT_NEAR(shown, value, 1e-9 * std::max(1.0, std::abs(value)));
-      // The text is the value, rounded for reading (thousands separated).
+      // The text is the value rounded to the decimals it shows (thousands separated): within half its last digit.
       std::string digits = text;
       digits.erase(std::remove(digits.begin(), digits.end(), ','), digits.end());
-      EXPECT_NEAR(std::stod(digits), value, 0.006 * std::max(1.0, std::abs(value)));
+      const size_t point = digits.find('.');
+      const int decimals = point == std::string::npos ? 0 : static_cast<int>(digits.size() - point - 1);
+      EXPECT_NEAR(std::stod(digits), value, 0.5 * std::pow(10.0, -decimals) + 1e-9 * std::abs(value));
     }
   }
   EXPECT_EQ(cells.at({0, "planes_detected"}).first,
