@@ -142,9 +142,9 @@ void DrawLegend(cv::Mat& panel, double scale) {
   for (int dy = -r; dy <= r; ++dy) {
     for (int dx = -r; dx <= r; ++dx) {
       const double x = static_cast<double>(dx) / r, yy = static_cast<double>(dy) / r;
-      const double z2 = 1 - x * x - yy * yy;  // may round below 0 on the rim, where x*x + yy*yy is 1
       if (x * x + yy * yy > 1) continue;
-      const cv::Scalar col = NormalColour(Eigen::Vector3d(x, yy, -std::sqrt(std::max(0.0, z2))));
+      // On the rim 1 - x*x - yy*yy may round below 0 (and its root be NaN).
+      const cv::Scalar col = NormalColour(Eigen::Vector3d(x, yy, -std::sqrt(std::max(0.0, 1 - x * x - yy * yy))));
       panel.at<cv::Vec3b>(c.y + dy, c.x + dx) =
           cv::Vec3b(static_cast<uchar>(col[0]), static_cast<uchar>(col[1]), static_cast<uchar>(col[2]));
     }
