@@ -155,7 +155,7 @@ double PlanePurity::Share(int min_points, long* points) const {
 namespace detail {
 
 cv::Size ComparisonSize(const Annotation& reference, const Annotation& estimate, int max_width, const char* what) {
-  CheckSameImageSize(reference, std::string(what) + ": the reference", estimate, std::string(what) + ": the estimate");
+  CheckSameImageSize(reference, "the reference", estimate, std::string(what) + ": the estimate");
   const double scale = std::min(1.0, static_cast<double>(max_width) / reference.image_width);
   return {static_cast<int>(std::lround(reference.image_width * scale)),
           static_cast<int>(std::lround(reference.image_height * scale))};
