@@ -109,7 +109,7 @@ void CheckYamlText(const std::string& text, const std::string& where) {
   PDVO_THROW_CHECK(yaml_parser_initialize(&parser), Error, where << ": cannot start a YAML parser");
   const std::unique_ptr<yaml_parser_t, void (*)(yaml_parser_t*)> owner(&parser, yaml_parser_delete);
   yaml_parser_set_input_string(&parser, reinterpret_cast<const unsigned char*>(body.data()), body.size());
-  int depth = 0;
+  int depth = 0, documents = 0;
   bool top = true;  // the next node is the document's top level
   MatrixSize matrix;
   for (;;) {
@@ -153,7 +153,11 @@ void CheckYamlText(const std::string& text, const std::string& where) {
                        where << ": YAML nested deeper than " << kMaxYamlDepth << " levels");
     }
     if (type == YAML_MAPPING_END_EVENT || type == YAML_SEQUENCE_END_EVENT) --depth;
-    if (type == YAML_DOCUMENT_START_EVENT) top = true;
+    if (type == YAML_DOCUMENT_START_EVENT) {
+      // The project's files are one document; OpenCV 4.6's reader never returns on some with two (found by fuzzing).
+      PDVO_THROW_CHECK(++documents == 1, FormatError, where << ": line " << line << ": a second YAML document");
+      top = true;
+    }
   }
 }
 

@@ -188,6 +188,8 @@ TEST(Options, YamlThatWouldHangOrCrashOpenCvIsRefused) {
   EXPECT_NE(message_of("%YAML:1.0\nm: !!opencv-matrix\n  rows: 2\n  cols: ~\n  dt: d\n  data: [1, 2]\n")
                 .find("line 2: a matrix of a size that is not a whole number"),
             std::string::npos);
+  // A second document (fuzzer: OpenCV never returned on this one).
+  EXPECT_EQ(message_of("%YAML:1.0\n cx: A\n---\n-a: 5\n"), where + ": line 3: a second YAML document");
   // Cut short: refused at the end of the input.
   EXPECT_EQ(message_of("%YAML:1.0\nouter: {scale: [1").rfind(where + ": not valid YAML (line ", 0), 0u);
   // OpenCV's own header, with and without the document start, and a plain YAML file are taken.
