@@ -57,22 +57,29 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     // Its match: the detected plane of highest IoU, if at least match_iou.
     int best = -1;
     double best_iou = options.match_iou;
+    long largest = 0, detected = 0;  // the largest overlap with one detected plane; all detected plane pixels on it
     for (const auto& [key, inter] : overlap) {
       if (key.first != r || key.second < 0) continue;
       const int d = key.second;
       const double iou = inter / static_cast<double>(area + det_area[d] - inter);
       if (iou >= best_iou) best = d, best_iou = iou;
+      largest = std::max(largest, inter);
+      detected += inter;
     }
-    if (best < 0) continue;
-    det_matched[best] = true;
-    const AnnotationShape& ds = detection.shapes[best];
-    if (!rs.normal || !ds.normal) continue;
-    const double angle = AngleDeg(*rs.normal, *ds.normal);
-    s.normal_errors_deg.push_back(angle);
-    if (counted) {
-      s.matched_10 += angle <= 10;
-      s.matched_30 += angle <= 30;
+    double angle = 180;
+    if (best >= 0) {
+      det_matched[best] = true;
+      const AnnotationShape& ds = detection.shapes[best];
+      if (rs.normal && ds.normal) {
+        angle = AngleDeg(*rs.normal, *ds.normal);
+        s.normal_errors_deg.push_back(angle);
+      }
     }
+    if (!counted) continue;
+    s.matched_10 += angle <= 10;
+    s.matched_30 += angle <= 30;
+    if (angle <= 30) continue;
+    (best >= 0 ? s.turned : 2 * largest >= area ? s.merged : 2 * detected >= area ? s.fragmented : s.missed) += 1;
   }
   for (const auto& [d, area] : det_area) s.spurious_planes += !det_matched[d];
   // Segmentation over the reference plane pixels, from the contingency table `overlap`.
@@ -122,6 +129,7 @@ DetectionSummary Summarise(const std::vector<DetectionScore>& scores) {
     matched_10 += s.matched_10, matched_30 += s.matched_30;
     errors.insert(errors.end(), s.normal_errors_deg.begin(), s.normal_errors_deg.end());
     m.spurious_planes += s.spurious_planes;
+    m.turned += s.turned, m.merged += s.merged, m.fragmented += s.fragmented, m.missed += s.missed;
     if (s.segmentation_pixels > 1) {
       ++segmented;
       m.rand_index += s.rand_index;
@@ -152,40 +160,45 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
   const DetectionSummary m = Summarise(scores);
   nlohmann::json images = nlohmann::json::array();
   for (const DetectionScore& s : scores) {
-    images.push_back({{"name", s.name},
-                      {"pixels",
-                       {{"plane_as_plane", s.plane_as_plane},
-                        {"plane_as_nonplane", s.plane_as_nonplane},
-                        {"plane_as_none", s.plane_as_none},
-                        {"nonplane_as_plane", s.nonplane_as_plane},
-                        {"nonplane_as_nonplane", s.nonplane_as_nonplane},
-                        {"nonplane_as_none", s.nonplane_as_none}}},
-                      {"reference_planes", s.reference_planes},
-                      {"matched_10", s.matched_10},
-                      {"matched_30", s.matched_30},
-                      {"normal_errors_deg", s.normal_errors_deg},
-                      {"spurious_planes", s.spurious_planes},
-                      {"rand_index", s.rand_index},
-                      {"variation_of_information", s.variation_of_information},
-                      {"covering", s.covering}});
+    images.push_back(
+        {{"name", s.name},
+         {"pixels",
+          {{"plane_as_plane", s.plane_as_plane},
+           {"plane_as_nonplane", s.plane_as_nonplane},
+           {"plane_as_none", s.plane_as_none},
+           {"nonplane_as_plane", s.nonplane_as_plane},
+           {"nonplane_as_nonplane", s.nonplane_as_nonplane},
+           {"nonplane_as_none", s.nonplane_as_none}}},
+         {"reference_planes", s.reference_planes},
+         {"matched_10", s.matched_10},
+         {"matched_30", s.matched_30},
+         {"normal_errors_deg", s.normal_errors_deg},
+         {"spurious_planes", s.spurious_planes},
+         {"unmatched",
+          {{"turned", s.turned}, {"merged", s.merged}, {"fragmented", s.fragmented}, {"missed", s.missed}}},
+         {"rand_index", s.rand_index},
+         {"variation_of_information", s.variation_of_information},
+         {"covering", s.covering}});
   }
-  const nlohmann::json summary = {{"images", m.images},
-                                  {"plane_precision", m.plane_precision},
-                                  {"plane_recall", m.plane_recall},
-                                  {"plane_f1", m.plane_f1},
-                                  {"nonplane_precision", m.nonplane_precision},
-                                  {"nonplane_recall", m.nonplane_recall},
-                                  {"nonplane_f1", m.nonplane_f1},
-                                  {"false_plane_area", m.false_plane_area},
-                                  {"reference_planes", m.reference_planes},
-                                  {"plane_recall_10", m.plane_recall_10},
-                                  {"plane_recall_30", m.plane_recall_30},
-                                  {"mean_normal_error_deg", m.mean_normal_error_deg},
-                                  {"median_normal_error_deg", m.median_normal_error_deg},
-                                  {"spurious_planes", m.spurious_planes},
-                                  {"rand_index", m.rand_index},
-                                  {"variation_of_information_bits", m.variation_of_information},
-                                  {"covering", m.covering}};
+  const nlohmann::json summary = {
+      {"images", m.images},
+      {"plane_precision", m.plane_precision},
+      {"plane_recall", m.plane_recall},
+      {"plane_f1", m.plane_f1},
+      {"nonplane_precision", m.nonplane_precision},
+      {"nonplane_recall", m.nonplane_recall},
+      {"nonplane_f1", m.nonplane_f1},
+      {"false_plane_area", m.false_plane_area},
+      {"reference_planes", m.reference_planes},
+      {"plane_recall_10", m.plane_recall_10},
+      {"plane_recall_30", m.plane_recall_30},
+      {"mean_normal_error_deg", m.mean_normal_error_deg},
+      {"median_normal_error_deg", m.median_normal_error_deg},
+      {"spurious_planes", m.spurious_planes},
+      {"unmatched", {{"turned", m.turned}, {"merged", m.merged}, {"fragmented", m.fragmented}, {"missed", m.missed}}},
+      {"rand_index", m.rand_index},
+      {"variation_of_information_bits", m.variation_of_information},
+      {"covering", m.covering}};
   const std::string how =
       "pixels scored where the reference annotates; planes matched by IoU >= " + std::to_string(options.match_iou) +
       "; plane recall over reference planes of at least " + std::to_string(options.min_plane_share) + " of the image";

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <set>
 
 #include "pdvo/annotations/mask_polygons.h"
@@ -21,6 +23,8 @@ namespace {
 constexpr double kDegree = M_PI / 180;
 constexpr double kMinProbability = 1e-3;   // MRF 1's data terms: -log of probabilities clamped to this
 constexpr double kMaxOrientationCost = 4;  // MRF 2's data cost, at most
+constexpr int kMinColumnPixels = 8;        // a column of a plane's area with fewer pixels has no colour of its own
+constexpr int kMinPartPoints = 3;          // a part of a plane split by colour is kept down to this many points
 
 using Clock = std::chrono::steady_clock;
 double Ms(Clock::time_point from) { return std::chrono::duration<double, std::milli>(Clock::now() - from).count(); }
@@ -108,6 +112,56 @@ std::vector<std::vector<int>> Components(int n, const std::vector<std::pair<int,
 
 }  // namespace
 
+std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, double penalty, int min_width,
+                                  int min_pixels) {
+  PDVO_THROW_CHECK(lab.type() == CV_32FC3 && mask.type() == CV_8U && lab.size() == mask.size(), InvalidArgument,
+                   "colour columns: expected a CV_32FC3 image and a CV_8U mask of its size");
+  std::vector<int> column;              // the columns with enough pixels
+  std::vector<Eigen::Vector3d> colour;  // and their median colours
+  std::vector<float> channel[3];
+  for (int x = 0; x < lab.cols; ++x) {
+    for (auto& c : channel) c.clear();
+    for (int y = 0; y < lab.rows; ++y) {
+      if (!mask.at<uchar>(y, x)) continue;
+      const cv::Vec3f& v = lab.at<cv::Vec3f>(y, x);
+      for (int k = 0; k < 3; ++k) channel[k].push_back(v[k]);
+    }
+    if (static_cast<int>(channel[0].size()) < min_pixels) continue;
+    Eigen::Vector3d median;
+    for (int k = 0; k < 3; ++k) {
+      std::nth_element(channel[k].begin(), channel[k].begin() + channel[k].size() / 2, channel[k].end());
+      median[k] = channel[k][channel[k].size() / 2];
+    }
+    column.push_back(x);
+    colour.push_back(median);
+  }
+  const int m = static_cast<int>(column.size());
+  if (m == 0) return {};
+  std::vector<Eigen::Vector3d> sum(m + 1, Eigen::Vector3d::Zero());
+  std::vector<double> squares(m + 1, 0);
+  for (int i = 0; i < m; ++i) sum[i + 1] = sum[i] + colour[i], squares[i + 1] = squares[i] + colour[i].squaredNorm();
+  auto cost = [&](int i, int j) {  // columns i..j-1 as one run
+    const Eigen::Vector3d s = sum[j] - sum[i];
+    return squares[j] - squares[i] - s.squaredNorm() / (j - i);
+  };
+  // best[j]: the least cost of columns 0..j-1 as runs; from[j]: where its last run starts.
+  std::vector<double> best(m + 1, std::numeric_limits<double>::infinity());
+  std::vector<int> from(m + 1, 0);
+  best[0] = 0;
+  for (int j = 1; j <= m; ++j) {
+    for (int i = 0; i < j; ++i) {
+      const bool wide = column[j - 1] - column[i] + 1 >= min_width;
+      if (!wide && !(i == 0 && j == m)) continue;  // too narrow a run, unless it is the whole
+      const double c = best[i] + cost(i, j) + penalty;
+      if (c < best[j]) best[j] = c, from[j] = i;
+    }
+  }
+  std::vector<int> cuts;
+  for (int j = m; from[j] > 0; j = from[j]) cuts.push_back(column[from[j]]);
+  std::reverse(cuts.begin(), cuts.end());
+  return cuts;
+}
+
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
                          double normal_scale_deg) {
   const size_t n = points.size();
@@ -140,6 +194,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(distance_scale > 0 && colour_scale > 0 && plane_smoothness >= 0);
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
+  PDVO_CHECK_OPTION(column_split_penalty >= 0 && column_split_width >= 1);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
   PDVO_CHECK_OPTION(cell_radius > 0);
   return true;
@@ -305,30 +360,62 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     }
     return mask;
   };
-  for (const std::vector<int>& members : Components(n, edges, d.orientation)) {
-    if (static_cast<int>(members.size()) < o.min_segment_points) continue;
+  // A plane segment of these points, recognised again (its final normal and score), or none if the recognition
+  // rejects it (without re-recognition: its points' robust mean normal and mean planarity).
+  auto plane_of = [&](const std::vector<int>& members) -> std::optional<DetectedSegment> {
     DetectedSegment s;
     s.planar = true;
     s.points = members;
     s.mask = area_of(members);
     const cv::Rect box = cv::boundingRect(s.mask);
-    if (box.area() == 0) continue;
+    if (box.area() == 0) return std::nullopt;
     if (o.rerecognise) {
       const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
-      if (!p.valid || p.plane_probability < o.min_plane_probability) continue;
+      if (!p.valid || p.plane_probability < o.min_plane_probability) return std::nullopt;
       s.normal = p.normal;
       s.score = p.plane_probability;
-    } else {
-      std::vector<Eigen::Vector3d> member_normals;
-      std::vector<double> member_weights;
-      for (const int i : members) {
-        member_normals.push_back(d.normals[i]);
-        member_weights.push_back(d.planarity[i]);
-        s.score += d.planarity[i] / static_cast<double>(members.size());
-      }
-      s.normal = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+      return s;
     }
-    d.segments.push_back(std::move(s));
+    std::vector<Eigen::Vector3d> member_normals;
+    std::vector<double> member_weights;
+    for (const int i : members) {
+      member_normals.push_back(d.normals[i]);
+      member_weights.push_back(d.planarity[i]);
+      s.score += d.planarity[i] / static_cast<double>(members.size());
+    }
+    s.normal = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    return s;
+  };
+  cv::Mat lab;
+  if (o.column_split_penalty > 0) {
+    work.convertTo(lab, CV_32F, 1.0 / 255);
+    cv::cvtColor(lab, lab, cv::COLOR_BGR2Lab);
+  }
+  for (const std::vector<int>& members : Components(n, edges, d.orientation)) {
+    if (static_cast<int>(members.size()) < o.min_segment_points) continue;
+    std::optional<DetectedSegment> s = plane_of(members);
+    if (!s) continue;
+    // A vertical plane is split where its colour changes along the image's columns (one facade meeting the next);
+    // each part is recognised again, and takes the whole's recognition if its own fails.
+    std::vector<int> cuts;
+    if (o.column_split_penalty > 0 && std::abs(s->normal.dot(words.edges.up)) < model.options.vanishing.horizontal_cos)
+      cuts = ColourColumnCuts(lab, s->mask, o.column_split_penalty, o.column_split_width, kMinColumnPixels);
+    if (cuts.empty()) {
+      d.segments.push_back(std::move(*s));
+      continue;
+    }
+    std::vector<std::vector<int>> parts(cuts.size() + 1);  // a run's points, whether the graph joins them or not
+    for (const int i : members)
+      parts[std::upper_bound(cuts.begin(), cuts.end(), NearestPixel(d.points[i]).x) - cuts.begin()].push_back(i);
+    for (const std::vector<int>& part : parts) {
+      if (static_cast<int>(part.size()) < kMinPartPoints) continue;
+      std::optional<DetectedSegment> p = plane_of(part);
+      if (!p) {
+        p = DetectedSegment{true, part, area_of(part), s->normal, s->score};
+        if (cv::countNonZero(p->mask) == 0) continue;
+      }
+      d.segments.push_back(std::move(*p));
+    }
   }
   for (const std::vector<int>& members : Components(n, edges, non_planar)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;

@@ -1,6 +1,7 @@
 // Detection scores on hand-made annotations with known answers: a perfect detection; one plane over the whole
 // image with a turned normal (half its area false, matched within 30 degrees but not 10); a plane detected as two
-// halves (Rand index about one half, one bit of variation of information, covering one half).
+// halves (Rand index about one half, one bit of variation of information, covering one half); why planes are not
+// matched.
 #include "pdvo/eval/detection.h"
 
 #include <gtest/gtest.h>
@@ -74,6 +75,31 @@ TEST(DetectionScore, APlaneInTwoHalves) {
   Annotation other = Reference();
   other.image_width = 50;
   EXPECT_THROW(ScoreDetection(Reference(), other), FormatError);
+}
+
+// Why a reference plane (the left half, 50 x 80) is not matched: a detection holding all of it and the non-plane
+// beside it, and more (IoU 0.4): merged; four quarters of it (none half): fragmented; a quarter only: missed; the
+// right area with a normal 40 degrees off: turned.
+TEST(DetectionScore, SaysWhyAPlaneIsNotMatched) {
+  const auto unmatched = [](const DetectionScore& s) {
+    return std::vector<int>{s.merged, s.fragmented, s.missed, s.turned};
+  };
+  const Eigen::Vector3d turned(std::sin(40 * M_PI / 180), 0, -std::cos(40 * M_PI / 180));
+  Annotation wide = Image({Rect(kPlaneLabel, -0.5, -0.5, 124.5, 79.5, kFacing)});
+  wide.image_width = 125;  // the whole image: the reference plane and 75 columns more, IoU 0.4
+  Annotation reference = Reference();
+  reference.image_width = 125;
+  EXPECT_EQ(unmatched(ScoreDetection(reference, wide)), (std::vector<int>{1, 0, 0, 0}));
+  EXPECT_EQ(unmatched(ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 24.5, 39.5, kFacing),
+                                                         Rect(kPlaneLabel, 24.5, -0.5, 49.5, 39.5, kFacing),
+                                                         Rect(kPlaneLabel, -0.5, 39.5, 24.5, 79.5, kFacing),
+                                                         Rect(kPlaneLabel, 24.5, 39.5, 49.5, 79.5, kFacing)}))),
+            (std::vector<int>{0, 1, 0, 0}));
+  EXPECT_EQ(unmatched(ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 24.5, 39.5, kFacing)}))),
+            (std::vector<int>{0, 0, 1, 0}));
+  EXPECT_EQ(unmatched(ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 49.5, 79.5, turned)}))),
+            (std::vector<int>{0, 0, 0, 1}));
+  EXPECT_EQ(unmatched(ScoreDetection(Reference(), Reference())), (std::vector<int>{0, 0, 0, 0}));
 }
 
 }  // namespace

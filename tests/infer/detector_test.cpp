@@ -32,6 +32,32 @@ TEST(Detector, PoolsTheWindowsThatHoldAPoint) {
   EXPECT_EQ(p.normals[2], Eigen::Vector3d::Zero());
 }
 
+// Columns of two colours, each with a window pattern of a third colour in a minority of every column: one cut, at
+// the change; one colour with the same windows: none; a change too near the edge to pay for a run of min_width: none.
+TEST(Detector, ColourColumnCutsFindWhereAFacadeChangesColour) {
+  const auto facade = [](int change) {
+    cv::Mat lab(60, 100, CV_32FC3);
+    for (int y = 0; y < lab.rows; ++y) {
+      for (int x = 0; x < lab.cols; ++x) {
+        const bool window = (y % 20) < 8 && (x % 10) < 6;  // 40% of a window column's pixels
+        lab.at<cv::Vec3f>(y, x) = window       ? cv::Vec3f(30, 0, -30)
+                                  : x < change ? cv::Vec3f(70, 20, 10)
+                                               : cv::Vec3f(70, -20, 10);
+      }
+    }
+    return lab;
+  };
+  const cv::Mat mask(60, 100, CV_8U, cv::Scalar(255));
+  EXPECT_EQ(ColourColumnCuts(facade(37), mask, 3000, 12, 8), std::vector<int>{37});
+  EXPECT_TRUE(ColourColumnCuts(facade(100), mask, 3000, 12, 8).empty());
+  EXPECT_TRUE(ColourColumnCuts(facade(97), mask, 3000, 12, 8).empty());  // 3 columns cannot pay for a run of 12
+  // Only the mask's pixels count: the change lies outside it.
+  cv::Mat left = cv::Mat::zeros(60, 100, CV_8U);
+  left.colRange(0, 30).setTo(255);
+  EXPECT_TRUE(ColourColumnCuts(facade(37), left, 3000, 12, 8).empty());
+  EXPECT_THROW(ColourColumnCuts(facade(37), cv::Mat(60, 99, CV_8U), 3000, 12, 8), InvalidArgument);
+}
+
 struct StreetFrame {
   cv::Mat image;
   Annotation truth;

@@ -9,6 +9,10 @@
 // - plane recall: of the reference planes covering at least `min_plane_share` of the image, the share whose best
 //   overlapping detected plane has IoU >= `match_iou` and a normal within 10, and within 30, degrees; the normal
 //   errors of every reference plane so matched; detected planes that are no reference plane's match are spurious;
+//   each counted reference plane that is not matched within 30 degrees is put down to one cause: its best match's
+//   normal is over 30 degrees off (turned); the detected plane overlapping it most holds at least half of it but is
+//   too large for IoU match_iou (merged: it runs onto other planes or non-planes); detected planes cover at least
+//   half of it, but none half (fragmented); less than half of it is detected as plane (missed);
 // - segmentation over the reference's plane pixels, each reference plane a segment and each detected plane a
 //   segment (pixels on no detected plane one more): Rand index, variation of information (bits), and the
 //   covering of the reference by the detection (each reference segment's best IoU, weighted by its size).
@@ -37,6 +41,7 @@ struct DetectionScore {
   int matched_10 = 0, matched_30 = 0;     // of them, matched with a normal within 10 / 30 degrees
   std::vector<double> normal_errors_deg;  // of the reference planes matched by IoU (any angle, any size)
   int spurious_planes = 0;                // detected planes that are no reference plane's match
+  int turned = 0, merged = 0, fragmented = 0, missed = 0;  // counted reference planes not matched within 30 degrees
   double rand_index = 1, variation_of_information = 0, covering = 1;  // 1, 0, 1 without reference planes
   long segmentation_pixels = 0;  // the reference plane pixels the segmentation figures are over
 };
@@ -54,6 +59,7 @@ struct DetectionSummary {
   double plane_recall_10 = 0, plane_recall_30 = 0;
   double mean_normal_error_deg = 0, median_normal_error_deg = 0;  // over matched planes
   int spurious_planes = 0;
+  int turned = 0, merged = 0, fragmented = 0, missed = 0;
   double rand_index = 0, variation_of_information = 0, covering = 0;  // means over images with plane pixels
 };
 DetectionSummary Summarise(const std::vector<DetectionScore>& scores);

@@ -8,7 +8,9 @@
 //      graph cut; MRF 2 labels the planar points with orientations found by mean shift on their normals, by
 //      alpha-expansion (mrf.h). Connected points of one label are a segment.
 //   4. Each segment (its points' Voronoi cells, clipped near the points) is recognised again as a region for its
-//      final normal and plane probability; small segments and those the recognition rejects are dropped.
+//      final normal and plane probability; small segments and those the recognition rejects are dropped. A
+//      vertical plane is split where its colour changes along the image's columns (one facade meeting the next,
+//      ColourColumnCuts), and each part recognised again.
 // Pixels are the working image's (the model's working width); normals are unit, camera frame, towards the camera.
 #pragma once
 
@@ -42,8 +44,12 @@ struct DetectorOptions {
   double orientation_scale_deg = 20;    // MRF 2's data cost: (angle / scale)^2, at most 4
   double orientation_smoothness = 1.5;  // MRF 2's Potts weight on a full-weight edge
   int min_segment_points = 10;          // smaller segments are dropped
-  double min_plane_probability = 0.5;   // a plane segment recognised again below this is dropped
-  double cell_radius = 16;              // px: a segment's area is its points' Voronoi cells within this distance
+  // A vertical plane segment is split where its colour changes along the image's columns (ColourColumnCuts: the
+  // penalty per part, in squared CIELAB units summed over columns; 0: no split), and the parts recognised again.
+  double column_split_penalty = 3000;
+  int column_split_width = 12;         // px: the narrowest part
+  double min_plane_probability = 0.5;  // a plane segment recognised again below this is dropped
+  double cell_radius = 16;             // px: a segment's area is its points' Voronoi cells within this distance
   // The stages, for measuring what each adds. Off: a point is planar if its planarity exceeds 0.5 (MRF 1); takes
   // its nearest orientation (MRF 2); a segment's normal is its points' robust mean and its score their mean
   // planarity, and it is kept (re-recognition).
@@ -68,6 +74,8 @@ struct DetectorOptions {
     visit("orientation_scale_deg", self.orientation_scale_deg);
     visit("orientation_smoothness", self.orientation_smoothness);
     visit("min_segment_points", self.min_segment_points);
+    visit("column_split_penalty", self.column_split_penalty);
+    visit("column_split_width", self.column_split_width);
     visit("min_plane_probability", self.min_plane_probability);
     visit("cell_radius", self.cell_radius);
     visit("mrf_planes", self.mrf_planes);
@@ -93,6 +101,15 @@ struct PointPooling {
 };
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
                          double normal_scale_deg);
+
+// The columns at which a vertical plane's area changes colour, as where one building's facade meets the next:
+// each column's colour is the median over the mask's pixels in it (a facade's windows, a minority of most
+// columns, do not count); the columns with at least `min_pixels` are cut into runs of at least `min_width` columns
+// minimising the sum of squared differences to each run's mean colour plus `penalty` per run (dynamic
+// programming, exact). `lab`: CV_32FC3; `mask`: CV_8U of its size. Returns the first column of every run after
+// the first, increasing.
+std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, double penalty, int min_width,
+                                  int min_pixels);
 
 struct DetectedSegment {
   bool planar = false;
