@@ -79,7 +79,7 @@ TEST(DetectionScore, APlaneInTwoHalves) {
 
 // Why a reference plane (the left half, 50 x 80) is not matched: a detection holding all of it and the non-plane
 // beside it, and more (IoU 0.4): merged; four quarters of it (none half): fragmented; a quarter only: missed; the
-// right area with a normal 40 degrees off: turned.
+// plane itself with a normal 40 degrees off: turned.
 TEST(DetectionScore, SaysWhyAPlaneIsNotMatched) {
   const auto unmatched = [](const DetectionScore& s) {
     return std::vector<int>{s.merged, s.fragmented, s.missed, s.turned};

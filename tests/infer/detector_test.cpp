@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <thread>
 
 #include "pdvo/annotations/raster.h"
@@ -56,6 +57,52 @@ TEST(Detector, ColourColumnCutsFindWhereAFacadeChangesColour) {
   left.colRange(0, 30).setTo(255);
   EXPECT_TRUE(ColourColumnCuts(facade(37), left, 3000, 12, 8).empty());
   EXPECT_THROW(ColourColumnCuts(facade(37), cv::Mat(60, 99, CV_8U), 3000, 12, 8), InvalidArgument);
+}
+
+// The dynamic programme against brute force: on random rows of up to 12 one-pixel columns, the cuts it returns
+// cost as little as the best of every set of cuts whose runs are at least min_width wide (or one run).
+TEST(Detector, ColourColumnCutsAreOptimal) {
+  cv::RNG rng(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int m = rng.uniform(1, 13), min_width = rng.uniform(1, 4);
+    const double penalty = rng.uniform(0.0, 400.0);
+    cv::Mat lab(1, m, CV_32FC3);
+    for (int x = 0; x < m; ++x) {
+      lab.at<cv::Vec3f>(0, x) = cv::Vec3f(rng.uniform(0.f, 100.f), rng.uniform(-20.f, 20.f), rng.uniform(-20.f, 20.f));
+    }
+    const auto cost = [&](const std::vector<int>& cuts) {  // runs' squared differences to their means, plus penalties
+      std::vector<int> bounds = {0};
+      bounds.insert(bounds.end(), cuts.begin(), cuts.end());
+      bounds.push_back(m);
+      double total = 0;
+      for (size_t r = 0; r + 1 < bounds.size(); ++r) {
+        cv::Vec3d mean(0, 0, 0);
+        for (int x = bounds[r]; x < bounds[r + 1]; ++x) mean += cv::Vec3d(lab.at<cv::Vec3f>(0, x));
+        mean /= bounds[r + 1] - bounds[r];
+        for (int x = bounds[r]; x < bounds[r + 1]; ++x) {
+          const cv::Vec3d d = cv::Vec3d(lab.at<cv::Vec3f>(0, x)) - mean;
+          total += d.dot(d);
+        }
+        total += penalty;
+      }
+      return total;
+    };
+    double best = std::numeric_limits<double>::infinity();
+    for (int set = 0; set < (1 << std::max(0, m - 1)); ++set) {  // bit k: a cut before column k + 1
+      std::vector<int> cuts;
+      for (int k = 0; k + 1 < m; ++k) {
+        if (set >> k & 1) cuts.push_back(k + 1);
+      }
+      bool wide = true;
+      for (size_t r = 0; r <= cuts.size(); ++r) {
+        const int from = r == 0 ? 0 : cuts[r - 1], to = r == cuts.size() ? m : cuts[r];
+        wide = wide && (to - from >= min_width || cuts.empty());
+      }
+      if (wide) best = std::min(best, cost(cuts));
+    }
+    const std::vector<int> cuts = ColourColumnCuts(lab, cv::Mat(1, m, CV_8U, cv::Scalar(255)), penalty, min_width, 1);
+    EXPECT_NEAR(cost(cuts), best, 1e-6 * (1 + best)) << "trial " << trial << ", " << m << " columns";
+  }
 }
 
 struct StreetFrame {
