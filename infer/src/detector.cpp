@@ -360,13 +360,13 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     }
     return mask;
   };
-  // A plane segment of these points, recognised again (its final normal and score), or none if the recognition
-  // rejects it (without re-recognition: its points' robust mean normal and mean planarity).
-  auto plane_of = [&](const std::vector<int>& members) -> std::optional<DetectedSegment> {
+  // A plane segment of these points and this area, recognised again (its final normal and score), or none if the
+  // recognition rejects it (without re-recognition: its points' robust mean normal and mean planarity).
+  auto plane_of = [&](const std::vector<int>& members, cv::Mat mask) -> std::optional<DetectedSegment> {
     DetectedSegment s;
     s.planar = true;
     s.points = members;
-    s.mask = area_of(members);
+    s.mask = std::move(mask);
     const cv::Rect box = cv::boundingRect(s.mask);
     if (box.area() == 0) return std::nullopt;
     if (o.rerecognise) {
@@ -393,10 +393,11 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   }
   for (const std::vector<int>& members : Components(n, edges, d.orientation)) {
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
-    std::optional<DetectedSegment> s = plane_of(members);
+    std::optional<DetectedSegment> s = plane_of(members, area_of(members));
     if (!s) continue;
-    // A vertical plane is split where its colour changes along the image's columns (one facade meeting the next);
-    // each part is recognised again, and takes the whole's recognition if its own fails.
+    // A vertical plane is split where its colour changes along the image's columns (one facade meeting the next):
+    // each part, its points and its area within a run of columns, is recognised again, and takes the whole's
+    // recognition if its own fails.
     std::vector<int> cuts;
     if (o.column_split_penalty > 0 && std::abs(s->normal.dot(words.edges.up)) < model.options.vanishing.horizontal_cos)
       cuts = ColourColumnCuts(lab, s->mask, o.column_split_penalty, o.column_split_width, kMinColumnPixels);
@@ -407,13 +408,14 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     std::vector<std::vector<int>> parts(cuts.size() + 1);  // a run's points, whether the graph joins them or not
     for (const int i : members)
       parts[std::upper_bound(cuts.begin(), cuts.end(), NearestPixel(d.points[i]).x) - cuts.begin()].push_back(i);
-    for (const std::vector<int>& part : parts) {
-      if (static_cast<int>(part.size()) < kMinPartPoints) continue;
-      std::optional<DetectedSegment> p = plane_of(part);
-      if (!p) {
-        p = DetectedSegment{true, part, area_of(part), s->normal, s->score};
-        if (cv::countNonZero(p->mask) == 0) continue;
-      }
+    for (size_t k = 0; k < parts.size(); ++k) {
+      if (static_cast<int>(parts[k].size()) < kMinPartPoints) continue;
+      cv::Mat mask = cv::Mat::zeros(s->mask.size(), CV_8U);  // the whole's area, within the run's columns
+      const int from = k == 0 ? 0 : cuts[k - 1], to = k == cuts.size() ? mask.cols : cuts[k];
+      s->mask.colRange(from, to).copyTo(mask.colRange(from, to));
+      if (cv::countNonZero(mask) == 0) continue;
+      std::optional<DetectedSegment> p = plane_of(parts[k], mask);
+      if (!p) p = DetectedSegment{true, parts[k], mask, s->normal, s->score};
       d.segments.push_back(std::move(*p));
     }
   }
