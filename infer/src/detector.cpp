@@ -119,9 +119,10 @@ std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, doubl
   std::vector<int> column;              // the columns with enough pixels
   std::vector<Eigen::Vector3d> colour;  // and their median colours
   std::vector<float> channel[3];
-  for (int x = 0; x < lab.cols; ++x) {
+  const cv::Rect box = cv::boundingRect(mask);  // the columns and rows outside it hold no pixel of the mask
+  for (int x = box.x; x < box.x + box.width; ++x) {
     for (auto& c : channel) c.clear();
-    for (int y = 0; y < lab.rows; ++y) {
+    for (int y = box.y; y < box.y + box.height; ++y) {
       if (!mask.at<uchar>(y, x)) continue;
       const cv::Vec3f& v = lab.at<cv::Vec3f>(y, x);
       for (int k = 0; k < 3; ++k) channel[k].push_back(v[k]);
