@@ -62,7 +62,10 @@ cv::Mat DrawOverlay(const cv::Mat& colour, const std::vector<vo::Observation>& o
   }
   char text[128];
   std::snprintf(text, sizeof(text), "t %.2f  %d/%d matched  %d points  %d planes%s", s.timestamp, s.measurements,
-                s.attempted, s.points, s.planes, s.lost ? "  LOST" : "");
+                s.attempted, s.points, s.planes,
+                s.health == vo::Health::kTracked ? ""
+                : s.lost                         ? "  LOST"
+                                                 : "  UNCERTAIN");
   cv::putText(out, text, cv::Point(4, 12), cv::FONT_HERSHEY_PLAIN, 0.8, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   return out;
 }
@@ -206,7 +209,7 @@ int RunVo(int argc, char** argv) {
   std::vector<double> times;
   int keyframes_gone = 0;
   double seconds = 0, waited = 0;
-  int lost = 0, keyframes = 0, update_failures = 0;
+  int lost = 0, uncertain = 0, keyframes = 0, update_failures = 0;
   const size_t total = max_frames > 0 ? std::min(max_frames, sequence->size()) : sequence->size();
   Progress progress("vo", total);
   cv::VideoWriter video;
@@ -240,12 +243,14 @@ int RunVo(int argc, char** argv) {
     }
     seconds += s.seconds;
     lost += s.lost;
+    uncertain += s.health == vo::Health::kUncertain;
     keyframes += s.keyframe;
     waited += s.detector_wait_seconds;
     stats.AddFrame({{"t", s.timestamp},
                     {"seconds", s.seconds},
                     {"attempted", s.attempted},
                     {"measurements", s.measurements},
+                    {"nis", s.nis},
                     {"points", s.points},
                     {"planes", s.planes},
                     {"plane_points", s.plane_points},
@@ -253,6 +258,8 @@ int RunVo(int argc, char** argv) {
                     {"state", s.state_size},
                     {"keyframe", s.keyframe},
                     {"lost", s.lost},
+                    {"health", OptionName(s.health)},
+                    {"segment", s.segment},
                     {"bootstrap", s.bootstrap},
                     {"update", vo::ToString(s.update)},
                     {"resident_mib", ResidentMiB()}});
@@ -275,6 +282,10 @@ int RunVo(int argc, char** argv) {
     PDVO_LOG(Warning) << "vo: the update failed and was skipped in " << update_failures
                       << " frames (stats.json: frames[].update)";
   }
+  if (uncertain + lost > 0) {
+    PDVO_LOG(Warning) << "vo: " << uncertain << " of " << tracked << " poses are uncertain and tracking was lost "
+                      << lost << " times: do not trust those poses (stats.json: frames[].health)";
+  }
   const Trajectory& trajectory = odometry.trajectory();  // with the poses the bootstrap revised
   WriteTrajectory(out.path("trajectory.txt"), trajectory, format);
   const vo::Map map = odometry.map();
@@ -292,6 +303,7 @@ int RunVo(int argc, char** argv) {
                                  {"fps", fps},
                                  {"keyframes", keyframes},
                                  {"lost", lost},
+                                 {"uncertain", uncertain},
                                  {"update_failures", update_failures},
                                  {"planes", mapping.planes},
                                  {"points_per_plane", mapping.points_per_plane},
@@ -317,11 +329,12 @@ int RunVo(int argc, char** argv) {
   stats.Finish(tail, pdvo);
   out.Commit();
   std::printf(
-      "%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times; %d planes, "
+      "%zu frames, tracking %.1f frames/s (the tracking thread%s), %d keyframes, lost %d times, %d uncertain; "
+      "%d planes, "
       "%.1f points per plane, mean area %.0f px; wrote %s\n",
       trajectory.size(), fps,
       waited > 0 ? (", and it waited " + std::to_string(waited).substr(0, 5) + " s for the detector").c_str() : "",
-      keyframes, lost, mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, out_dir.c_str());
+      keyframes, lost, uncertain, mapping.planes, mapping.points_per_plane, mapping.mean_plane_area, out_dir.c_str());
   return 0;
 }
 

@@ -9,7 +9,8 @@
 // `source=oracle` (the street's exact annotation of each keyframe); the tracking thread's time is its CPU time
 // (the detector's thread excluded; the deterministic schedule's waits excluded).
 // Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5,
-//        and for mode=pdvo source=model|oracle model=PATH)
+//        and for mode=pdvo source=model|oracle model=PATH; synth=FILE: the street's options, section synth:,
+//        e.g. synth=sim/config/driving.yaml for a car)
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   pdvo::vo::VoOptions vo_options;
   std::string source = "model", model_path = std::string(PDVO_SOURCE_DIR) + "/models/default/model.yml";
+  std::string synth_path;  // the street's options (section synth:), e.g. sim/config/driving.yaml
   for (int i = 3; i < argc; ++i) {
     const std::string arg = argv[i];
     const size_t eq = arg.find('=');
@@ -53,8 +55,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "vo_bench: expected option=value, got '%s'\n", argv[i]);
       return 2;
     }
-    if (arg.substr(0, eq) == "source" || arg.substr(0, eq) == "model") {
-      (arg.substr(0, eq) == "source" ? source : model_path) = arg.substr(eq + 1);
+    const std::string key = arg.substr(0, eq);
+    if (key == "source" || key == "model" || key == "synth") {
+      (key == "source" ? source : key == "model" ? model_path : synth_path) = arg.substr(eq + 1);
       continue;
     }
     try {
@@ -65,6 +68,12 @@ int main(int argc, char** argv) {
     }
   }
   pdvo::sim::SynthOptions options;
+  try {
+    if (!synth_path.empty()) options = pdvo::LoadOptions<pdvo::sim::SynthOptions>(synth_path, "synth");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vo_bench: %s\n", e.what());
+    return 2;
+  }
   const pdvo::Camera camera = options.MakeCamera();
   const double length = options.walk.speed * frames / options.walk.fps;
   const pdvo::sim::Street street = pdvo::sim::GenerateStreet(options.street, length + 30, seed);
@@ -103,7 +112,7 @@ int main(int argc, char** argv) {
   }
   const double before = ResidentMiB();
   pdvo::vo::Odometry odometry(working, vo_options, nullptr, detect);
-  int keyframes = 0, lost = 0, bootstrap = -1;
+  int keyframes = 0, lost = 0, uncertain = 0, bootstrap = -1;
   double measurements = 0, peak = before, nees_sum = 0, relative_nees_sum = 0;
   // The newest keyframe's orientation, estimated and true.
   Eigen::Quaterniond key_estimate = Eigen::Quaterniond::Identity();
@@ -137,6 +146,7 @@ int main(int argc, char** argv) {
     keyframes += s.keyframe;
     if (s.bootstrap) bootstrap = static_cast<int>(k);
     lost += s.lost;
+    uncertain += s.health == pdvo::vo::Health::kUncertain;
     measurements += s.measurements;
     if (s.lost || s.bootstrap) gauge = odometry.world_from_cam().rotation * walk[k].world_from_cam.rotation.conjugate();
     if (!s.lost && !s.bootstrap && k > 0) {
@@ -229,8 +239,10 @@ int main(int argc, char** argv) {
       "relative to the newest keyframe %.2f\n",
       nees_sum / std::max(1, nees_frames), 100.0 * nees_inside / std::max(1, nees_frames),
       relative_nees_sum / std::max(1, nees_frames));
-  std::printf("  measurements     %.1f per frame; %d keyframes; lost %d times; two-view bootstrap at frame %d\n",
-              measurements / frames, keyframes, lost, bootstrap);
+  std::printf(
+      "  measurements     %.1f per frame; %d keyframes; lost %d times, %d frames uncertain; two-view "
+      "bootstrap at frame %d\n",
+      measurements / frames, keyframes, lost, uncertain, bootstrap);
   if (plane_members > 0) {
     std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n", pure);
   }

@@ -24,6 +24,7 @@ bool WalkOptions::Check() const {
   PDVO_CHECK_OPTION(eye_height > 0.3 && eye_height < 3);
   PDVO_CHECK_OPTION(step_frequency >= 0 && bob >= 0 && sway >= 0 && shake_deg >= 0);
   PDVO_CHECK_OPTION(look_deg >= 0 && look_deg <= 180);
+  PDVO_CHECK_OPTION(corner_smoothing > 0 && corner_smoothing <= 50);
   PDVO_CHECK_OPTION(std::abs(lateral_offset) < 3);
   return true;
 }
@@ -312,11 +313,11 @@ Eigen::Vector3d PointAt(const Street& street, double s) {
   return street.centreline.back();
 }
 
-// The centreline smoothed over +-2.5 m, which rounds the corners.
-Eigen::Vector3d SmoothPointAt(const Street& street, double s) {
+// The centreline averaged over +-`half_width` m, which rounds the corners.
+Eigen::Vector3d SmoothPointAt(const Street& street, double s, double half_width) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   constexpr int kTaps = 11;
-  for (int k = 0; k < kTaps; ++k) sum += PointAt(street, s - 2.5 + 5.0 * k / (kTaps - 1));
+  for (int k = 0; k < kTaps; ++k) sum += PointAt(street, s - half_width + 2 * half_width * k / (kTaps - 1));
   return sum / kTaps;
 }
 
@@ -347,11 +348,13 @@ Trajectory WalkStreet(const Street& street, const WalkOptions& o, int frames, ui
   for (int i = 0; i < frames; ++i) {
     const double t = i / o.fps;
     const double s = start + o.speed * t;
-    const Eigen::Vector3d ahead = SmoothPointAt(street, s + 1.5) - SmoothPointAt(street, s - 1.5);
+    const Eigen::Vector3d ahead =
+        SmoothPointAt(street, s + 1.5, o.corner_smoothing) - SmoothPointAt(street, s - 1.5, o.corner_smoothing);
     const Eigen::Vector3d d = ahead.normalized();
     const Eigen::Vector3d right = RightOf(d);
     const double phase = M_PI * o.step_frequency * t;  // a step per half period of the sway
-    Eigen::Vector3d position = SmoothPointAt(street, s) + (o.lateral_offset + o.sway * std::sin(phase)) * right;
+    Eigen::Vector3d position =
+        SmoothPointAt(street, s, o.corner_smoothing) + (o.lateral_offset + o.sway * std::sin(phase)) * right;
     position.y() = -o.eye_height + o.bob * std::cos(2 * phase);
     const double deg = M_PI / 180;
     const double look = o.look_deg * deg * std::sin(2 * M_PI * look_frequency * t + look_phase);

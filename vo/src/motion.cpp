@@ -6,6 +6,7 @@ namespace pdvo::vo {
 
 bool MotionNoise::Check() const {
   PDVO_CHECK_OPTION(linear_acceleration > 0 && angular_acceleration > 0);
+  PDVO_CHECK_OPTION(max_adaptation >= 1);
   return true;
 }
 

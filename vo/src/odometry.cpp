@@ -4,6 +4,7 @@
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <set>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
@@ -20,6 +21,12 @@ constexpr double kGaugeSigma = 1e-6;
 constexpr size_t kMinPriorPoints = 5;
 // A point's patch is warped as the fronto-parallel plane at its inverse depth, at least this (1/m).
 constexpr double kMinWarpInverseDepth = 1e-3;
+// The motion noise's adaptation (MotionNoise::max_adaptation): the mean normalised innovation squared of a
+// frame's matches (2 expected of a consistent filter; about 0.2 on synthetic streets, whose motion is smooth)
+// above which the noise doubles, and under which it shrinks back by kAdaptationDecay.
+constexpr double kNisHigh = 1.0;
+constexpr double kNisLow = 0.3;
+constexpr double kAdaptationDecay = 1.2;
 
 }  // namespace
 
@@ -28,11 +35,16 @@ bool PriorOptions::Check() const {
   return true;
 }
 
+bool HealthOptions::Check() const {
+  PDVO_CHECK_OPTION(min_inliers >= 0 && min_inlier_share >= 0 && min_inlier_share <= 1 && max_nis > 0);
+  return true;
+}
+
 bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(working_width == 0 || (working_width >= 64 && working_width <= kMaxImageSide));
   PDVO_CHECK_OPTION(lost_after >= 1);
   if (!features.Check() || !search.Check() || !ransac.Check() || !prior.Check() || !bootstrap.Check() ||
-      !motion.Check() || !planes.Check() || !pdvo.Check()) {
+      !motion.Check() || !planes.Check() || !pdvo.Check() || !health.Check()) {
     return false;
   }
   PDVO_CHECK_OPTION(features.border > search.patch_half);
@@ -70,7 +82,11 @@ struct Odometry::Impl {
   int detections_failed = 0;
   double last_time = 0;
   bool started = false;
-  int frames_without_measurements = 0;
+  int frames_without_evidence = 0;    // in a row (Evidence)
+  std::set<int> doubtful_references;  // keyframes made from a pose in doubt, while features of theirs remain
+  int segment = 0;
+  double adaptation = 1;  // of the motion noise (MotionNoise::max_adaptation)
+  int rough_frames = 0;   // in a row whose innovations exceed kNisHigh
 
   FrameStats Track(const cv::Mat& grey, double timestamp, const cv::Mat& colour) {
     FrameStats stats;
@@ -81,15 +97,22 @@ struct Odometry::Impl {
       started = true;
       stats.keyframe = true;
     } else {
-      filter->Predict(timestamp - last_time, o.motion);
+      filter->Predict(timestamp - last_time, o.motion.Scaled(adaptation));
       tracks.LeaveView(camera, o.features.border, filter.get(), &record);
       const Search search = SearchFeatures(grey, &stats);
       const RobustUpdateResult update = UpdateRobustly(camera, o.ransac, search.matches, &rng, filter.get());
       Tally(search, update, &stats);
+      Adapt(stats);
+      const bool evidence = Evidence(stats);
+      frames_without_evidence = evidence ? 0 : frames_without_evidence + 1;
+      const bool consistent = stats.nis <= o.health.max_nis;
+      stats.health = evidence && consistent && !MostlyFromDoubt(search, update) ? Health::kTracked : Health::kUncertain;
       tracks.LeaveRejected(o.features, filter.get(), &record);
       grower.Grow(filter.get(), &tracks, &record);
       if (Lost()) {
         stats.lost = true;
+        stats.health = Health::kLost;
+        ++segment;
         CameraState at = filter->camera();
         if (!at.position.allFinite() || !at.orientation.coeffs().allFinite()) at = CameraState();
         record.KeepAll(*filter, tracks);
@@ -103,8 +126,10 @@ struct Odometry::Impl {
       } else if (static_cast<int>(tracks.Visible(*filter, camera, o.features.border).size()) <
                  o.features.min_features) {
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
+        if (stats.keyframe && !evidence) doubtful_references.insert(filter->references().rbegin()->first);
       }
     }
+    stats.segment = segment;
     if (detections) Detect(timestamp, colour, &stats);
     last_time = timestamp;
     trajectory.push_back({timestamp, filter->camera().world_from_cam()});
@@ -146,10 +171,29 @@ struct Odometry::Impl {
                         [&](const auto& k) { return k.second.frame == frame; });
   }
 
-  // Tracking has failed: a non-finite state, or no measurement for lost_after frames.
+  // The motion noise follows the matches' innovations (MotionNoise::max_adaptation).
+  // One frame's large innovations are a jump in the images (the health check flags it), not rougher motion: the
+  // noise grows from the second such frame in a row.
+  void Adapt(const FrameStats& stats) {
+    if (stats.measurements < o.health.min_inliers) return;
+    rough_frames = stats.nis > kNisHigh ? rough_frames + 1 : 0;
+    if (rough_frames >= 2) {
+      adaptation = std::min(o.motion.max_adaptation, 2 * adaptation);
+    } else if (stats.nis < kNisLow) {
+      adaptation = std::max(1.0, adaptation / kAdaptationDecay);
+    }
+  }
+
+  // Enough evidence for the frame's pose (HealthOptions).
+  bool Evidence(const FrameStats& stats) const {
+    return stats.update == UpdateStatus::kOk && stats.measurements >= o.health.min_inliers &&
+           stats.measurements >= o.health.min_inlier_share * stats.attempted;
+  }
+
+  // Tracking has failed: a non-finite state, or lost_after frames in a row without enough matches.
   bool Lost() const {
     return !filter->covariance().allFinite() || !filter->camera().position.allFinite() ||
-           frames_without_measurements >= o.lost_after;
+           frames_without_evidence >= o.lost_after;
   }
 
   // Starts at rest at `at` with generic priors, and arms the two-view bootstrap.
@@ -171,7 +215,8 @@ struct Odometry::Impl {
     filter = std::make_unique<Filter>(at, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     tracks = Tracks();
     record.NewFilter();
-    frames_without_measurements = 0;
+    frames_without_evidence = 0;
+    doubtful_references.clear();  // a new filter names its references afresh
     MakeKeyframe(grey, timestamp, priors);
   }
 
@@ -179,6 +224,7 @@ struct Odometry::Impl {
   struct Search {
     std::vector<PointMeasurement> matches;
     std::vector<std::pair<History*, size_t>> searched;
+    std::vector<double> nis;  // per match: its normalised innovation squared against the prediction
   };
   // Searches for every feature in view (at most max_measurements): predicts its pixel and innovation
   // covariance, warps its keyframe patch by its plane's homography (a point's: fronto-parallel), and searches by
@@ -201,6 +247,7 @@ struct Odometry::Impl {
                            SearchPatch(grey, patch, pixel, s, o.search, &found);
       if (matched) {
         out.matches.push_back({id, found, o.search.pixel_sigma, ray});
+        out.nis.push_back((found - pixel).dot(s.inverse() * (found - pixel)));
         out.searched.emplace_back(history, observations.size());
         history->misses = 0;
       } else {
@@ -241,9 +288,30 @@ struct Odometry::Impl {
     }
     stats->update = update.status;
     stats->measurements = static_cast<int>(std::count(update.used.begin(), update.used.end(), true));
-    for (size_t i = 0; i < update.used.size(); ++i)
+    double nis = 0;
+    for (size_t i = 0; i < update.used.size(); ++i) {
       stats->plane_measurements += update.used[i] && !search.matches[i].ray.isZero();
-    frames_without_measurements = stats->measurements == 0 ? frames_without_measurements + 1 : 0;
+      if (update.used[i]) nis += search.nis[i];
+    }
+    stats->nis = stats->measurements > 0 ? nis / stats->measurements : 0;
+  }
+
+  // True if most of the frame's used measurements are of features whose keyframe was made from a pose in doubt:
+  // then the pose is measured against a map that is itself in doubt.
+  bool MostlyFromDoubt(const Search& search, const RobustUpdateResult& update) {
+    std::erase_if(doubtful_references, [&](int r) { return !filter->references().contains(r); });
+    if (doubtful_references.empty()) return false;
+    int doubtful = 0, used = 0;
+    for (size_t i = 0; i < update.used.size(); ++i) {
+      if (!update.used[i]) continue;
+      const int id = search.matches[i].point;
+      const auto point = filter->points().find(id);
+      const int reference =
+          point != filter->points().end() ? point->second.reference : filter->planes().at(id).reference;
+      doubtful += doubtful_references.contains(reference);
+      ++used;
+    }
+    return 2 * doubtful > used;
   }
 
   // The mapped points as the current camera sees them: pixel and inverse distance.

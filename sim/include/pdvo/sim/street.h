@@ -110,6 +110,9 @@ struct WalkOptions {
   // Looking around: the gaze turns from the walking direction by up to this many degrees, slowly (a sinusoid of
   // period 12-30 s, random phase), so that some frames see the facades from the front. 0: always ahead.
   double look_deg = 0.0;
+  // The path is the street's centreline averaged over this many metres either side, which rounds the corners:
+  // a walker turns within a few metres, a car over tens of metres.
+  double corner_smoothing = 2.5;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -122,6 +125,7 @@ struct WalkOptions {
     visit("shake_deg", self.shake_deg);
     visit("lateral_offset", self.lateral_offset);
     visit("look_deg", self.look_deg);
+    visit("corner_smoothing", self.corner_smoothing);
   }
   bool Check() const;
   bool operator==(const WalkOptions&) const = default;

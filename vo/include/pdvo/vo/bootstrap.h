@@ -52,8 +52,9 @@ struct TwoViewMotion {
 
 // The essential matrix between corresponding pixels `first` and `second` (RANSAC, 1 px), its motion and the
 // triangulated inliers (in front of both views), scaled so that their median distance from the second view is
-// 1 / inverse_depth; false if fewer than kBootstrapInliers (or fewer than half) are inliers, or their median
-// parallax is under `parallax_deg`.
+// 1 / inverse_depth; false if fewer than kBootstrapInliers (or fewer than half) are inliers, if their median
+// parallax is under `parallax_deg`, or if a pure rotation would leave them under half of that (a turn in front of
+// a near wall is not a translation).
 bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first,
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
                      TwoViewMotion* motion);

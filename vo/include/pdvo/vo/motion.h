@@ -19,11 +19,23 @@ using Vector12d = Eigen::Matrix<double, 12, 1>;
 struct MotionNoise {
   double linear_acceleration = 0.25;  // m/s^2
   double angular_acceleration = 4.0;  // rad/s^2
+  // Adaptive: while the matches' innovations are larger than the prediction allows (their mean normalised
+  // innovation squared over 1 in two frames in a row), the odometry doubles both standard deviations each frame,
+  // up to this factor, and shrinks them back (by 1.2 a frame, under 0.3) when the motion calms down. 1: fixed.
+  double max_adaptation = 4.0;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
     visit("linear_acceleration", self.linear_acceleration);
     visit("angular_acceleration", self.angular_acceleration);
+    visit("max_adaptation", self.max_adaptation);
+  }
+  // The noise with both standard deviations times `factor`.
+  MotionNoise Scaled(double factor) const {
+    MotionNoise out = *this;
+    out.linear_acceleration *= factor;
+    out.angular_acceleration *= factor;
+    return out;
   }
   bool Check() const;
   bool operator==(const MotionNoise&) const = default;

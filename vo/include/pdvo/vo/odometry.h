@@ -15,6 +15,7 @@
 // (monocular: the scale is arbitrary).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -54,6 +55,36 @@ struct PriorOptions {
   bool operator==(const PriorOptions&) const = default;
 };
 
+// How far a frame's pose can be trusted, from the evidence the filter has (FrameStats::health):
+//   tracked    the update used at least min_inliers matches, at least min_inlier_share of the features searched
+//              for, their mean normalised innovation squared (FrameStats::nis) is at most max_nis (the camera
+//              moved as the motion model allowed: a jump or a stall of the images does not), and the map it
+//              measured against was made from trusted poses;
+//   uncertain  any of these fails; a keyframe made from a pose with too few inliers carries the doubt into its
+//              features: frames whose measurements are mostly of those features are uncertain;
+//   lost       tracking failed at this frame (lost_after frames in a row without enough matches, min_inliers and
+//              min_inlier_share, or a non-finite state) and started again: a new segment.
+// A segment is the frames between two starts: monocular odometry cannot relate one segment's poses to another's
+// (scale and pose start afresh), so they are compared with ground truth each on its own (pdvo ate --health).
+enum class Health { kTracked, kUncertain, kLost };
+constexpr std::array<std::pair<Health, const char*>, 3> OptionNames(Health) {
+  return {{{Health::kTracked, "tracked"}, {Health::kUncertain, "uncertain"}, {Health::kLost, "lost"}}};
+}
+struct HealthOptions {
+  int min_inliers = 6;            // matches used in the update
+  double min_inlier_share = 0.3;  // of the features searched for
+  double max_nis = 2;             // their mean normalised innovation squared (2 expected of a consistent filter)
+
+  template <class Self, class V>
+  static void Fields(Self& self, V& visit) {
+    visit("min_inliers", self.min_inliers);
+    visit("min_inlier_share", self.min_inlier_share);
+    visit("max_nis", self.max_nis);
+  }
+  bool Check() const;
+  bool operator==(const HealthOptions&) const = default;
+};
+
 // Every option of the odometry; vo/config/default.yaml lists them with their defaults.
 struct VoOptions {
   PlaneMode mode = PlaneMode::kPoints;  // where planes come from (plane_seeder.h)
@@ -61,7 +92,7 @@ struct VoOptions {
   // Keyframes' poses are taken as exact once made (Filter::AddReference): updates do not move the map with the
   // camera, and the camera's covariance is relative to its keyframes. Off: reference cameras stay in the state.
   bool fixed_references = true;
-  int lost_after = 5;  // frames without any measurement before starting again
+  int lost_after = 5;  // frames in a row without enough matches (HealthOptions) before starting again
   FeatureOptions features;
   SearchOptions search;
   RansacOptions ransac;
@@ -70,6 +101,7 @@ struct VoOptions {
   MotionNoise motion;
   PlaneOptions planes;
   PdvoOptions pdvo;  // mode pdvo: the detector's schedule and how its planes are seeded
+  HealthOptions health;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -85,6 +117,7 @@ struct VoOptions {
     visit("motion", self.motion);
     visit("planes", self.planes);
     visit("pdvo", self.pdvo);
+    visit("health", self.health);
   }
   bool Check() const;
   bool operator==(const VoOptions&) const = default;
@@ -103,13 +136,18 @@ struct FrameStats {
   double detector_wait_seconds = 0;  // mode pdvo, deterministic schedule: time spent waiting for the detector
   int attempted = 0;                 // features searched for
   int measurements = 0;              // matched and used in the update
-  int points = 0;                    // in the filter after the frame
+  // Their mean normalised innovation squared against the frame's prediction (2 expected; the search gates at
+  // search_sigmas^2).
+  double nis = 0;
+  int points = 0;  // in the filter after the frame
   int planes = 0;
   int plane_points = 0;        // points held by those planes
   int plane_measurements = 0;  // measurements of plane points used in the update
   int state_size = 0;
   bool keyframe = false;
-  bool lost = false;       // tracking failed at this frame and started again
+  bool lost = false;  // tracking failed at this frame and started again (health kLost)
+  Health health = Health::kTracked;
+  int segment = 0;         // starts so far (health above): frames of one segment share a frame of reference
   bool bootstrap = false;  // the filter started again here from the two-view bootstrap
   // The frame's update: kOk, kNoMeasurements (nothing matched, or no hypothesis had an inlier), or a failure
   // (the update was skipped and the filter left as predicted).
