@@ -264,6 +264,27 @@ TEST(Odometry, RefusesBadFrames) {
   EXPECT_THROW(Odometry(distorted, VoOptions{}), InvalidArgument);  // frames must be undistorted
 }
 
+// The two-view check of the health: the true motion between two frames of the street fits their tracked corners
+// (median epipolar error under a tenth of a degree), whatever the length of its translation; turned by 3 degrees
+// it misses by over a degree, standing still by several times as much as the truth; a blank frame cannot tell.
+TEST(Odometry, EpipolarDisagreementSeesAWrongMotion) {
+  const Street& s = TestStreet();
+  const Rigid3d truth = s.walk[40].world_from_cam.Inverse() * s.walk[60].world_from_cam;
+  const auto error = [&](const Rigid3d& motion) {
+    return EpipolarDisagreement(s.camera, s.grey[40], s.grey[60], motion, 10, 12);
+  };
+  ASSERT_TRUE(error(truth).has_value());
+  EXPECT_LT(*error(truth), 0.1);
+  EXPECT_LT(*error(Rigid3d(truth.rotation, 5 * truth.translation)), 0.1);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(3 * M_PI / 180, Eigen::Vector3d::UnitY()));
+  ASSERT_TRUE(error(Rigid3d(truth.rotation * turn, truth.translation)).has_value());
+  EXPECT_GT(*error(Rigid3d(truth.rotation * turn, truth.translation)), 1.0);
+  // Standing still misses the parallax of 0.9 m of walking (the far corners have little of it).
+  EXPECT_GT(error(Rigid3d(truth.rotation, Eigen::Vector3d::Zero())).value_or(0), 4 * *error(truth)) << *error(truth);
+  const cv::Mat blank(s.grey[60].size(), CV_8U, cv::Scalar(90));
+  EXPECT_FALSE(EpipolarDisagreement(s.camera, s.grey[40], blank, truth, 10, 12).has_value());
+}
+
 // The health check (Health): a clean street is tracked throughout; each planted fault in the images is flagged
 // at the frame it happens (frames ahead shown early and late, the same image held, a blank frame), and the track
 // is trusted again after it. Measured (mean normalised innovation squared per match): 0.0-0.3 on the clean

@@ -26,6 +26,10 @@ constexpr double kFarthest = 1e6;
 // Measured on the TUM fr1 excerpt: 0.33-0.75 give the same result; 0.25 lets such starts through.
 constexpr double kMinUnexplainedShare = 0.5;
 
+// EpipolarDisagreement: corners tracked, and the RANSAC confidence of its essential matrix.
+constexpr int kCheckCorners = 100;
+constexpr double kCheckConfidence = 0.99;
+
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -99,6 +103,43 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from,
   for (Eigen::Vector3d& x : motion->points) x *= scale;
   motion->first_from_second = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre * scale);
   return true;
+}
+
+std::optional<double> EpipolarDisagreement(const Camera& camera, const cv::Mat& first, const cv::Mat& second,
+                                           const Rigid3d& first_from_second, int border, double min_distance) {
+  std::vector<cv::Point2f> from, to;
+  cv::goodFeaturesToTrack(first, from, kCheckCorners, kCornerQuality, min_distance, InsideMask(first.size(), border));
+  if (from.size() < kBootstrapInliers) return std::nullopt;
+  std::vector<uchar> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(first, second, from, to, status, error, kFlowWindow, kFlowLevels);
+  size_t kept = 0;
+  for (size_t i = 0; i < from.size(); ++i) {
+    if (!status[i] || !Inside(Eigen::Vector2d(to[i].x, to[i].y), second.size(), border)) continue;
+    from[kept] = from[i];
+    to[kept++] = to[i];
+  }
+  from.resize(kept);
+  to.resize(kept);
+  if (kept < kBootstrapInliers) return std::nullopt;
+  // The essential matrix only sorts out tracks that fit no rigid motion; the filter's motion is what is tested.
+  cv::Mat inliers;
+  const cv::Mat e = cv::findEssentialMat(from, to, camera.K(), cv::RANSAC, kCheckConfidence, kRansacThreshold, inliers);
+  if (e.rows != 3 || e.cols != 3) return std::nullopt;
+  const Eigen::Matrix3d& rotation = first_from_second.rotation.toRotationMatrix();
+  const Eigen::Vector3d& baseline = first_from_second.translation;
+  std::vector<double> angles;
+  for (int i = 0; i < inliers.rows; ++i) {
+    if (!inliers.at<uchar>(i)) continue;
+    const Eigen::Vector3d b1 = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).normalized();
+    const Eigen::Vector3d b2 = rotation * camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized();
+    const Eigen::Vector3d normal = baseline.cross(b1);  // of the epipolar plane, in the first view's frame
+    angles.push_back(normal.norm() > 1e-12 * baseline.norm() && baseline.norm() > 0
+                         ? std::asin(std::min(1.0, std::abs(normal.normalized().dot(b2))))
+                         : std::acos(std::clamp(b1.dot(b2), -1.0, 1.0)));
+  }
+  if (angles.size() < kBootstrapInliers || 2 * angles.size() < kept) return std::nullopt;
+  return Median(angles) * 180 / M_PI;
 }
 
 TwoViewBootstrap::TwoViewBootstrap(const Camera& camera, const BootstrapOptions& options, int border,

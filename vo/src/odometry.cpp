@@ -37,6 +37,7 @@ bool PriorOptions::Check() const {
 
 bool HealthOptions::Check() const {
   PDVO_CHECK_OPTION(min_inliers >= 0 && min_inlier_share >= 0 && min_inlier_share <= 1 && max_nis > 0);
+  PDVO_CHECK_OPTION(max_epipolar_error > 0);
   return true;
 }
 
@@ -84,6 +85,8 @@ struct Odometry::Impl {
   bool started = false;
   int frames_without_evidence = 0;    // in a row (Evidence)
   std::set<int> doubtful_references;  // keyframes made from a pose in doubt, while features of theirs remain
+  cv::Mat last_keyframe;              // grey, for the two-view check of the next keyframe (MotionDisagrees)
+  Rigid3d last_keyframe_pose;         // its world_from_cam in the filter
   int segment = 0;
   double adaptation = 1;  // of the motion noise (MotionNoise::max_adaptation)
   int rough_frames = 0;   // in a row whose innovations exceed kNisHigh
@@ -125,8 +128,11 @@ struct Odometry::Impl {
         stats.keyframe = stats.bootstrap = true;
       } else if (static_cast<int>(tracks.Visible(*filter, camera, o.features.border).size()) <
                  o.features.min_features) {
+        const bool disagrees = MotionDisagrees(grey);
+        if (disagrees) stats.health = Health::kUncertain;
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
-        if (stats.keyframe && !evidence) doubtful_references.insert(filter->references().rbegin()->first);
+        if (stats.keyframe && (!evidence || disagrees))
+          doubtful_references.insert(filter->references().rbegin()->first);
       }
     }
     stats.segment = segment;
@@ -190,6 +196,21 @@ struct Odometry::Impl {
            stats.measurements >= o.health.min_inlier_share * stats.attempted;
   }
 
+  // True if the filter's motion since the last keyframe misses what the two frames show by more than
+  // health.max_epipolar_error (EpipolarDisagreement); false also when the frames cannot tell. This frame becomes
+  // the last keyframe.
+  bool MotionDisagrees(const cv::Mat& grey) {
+    const Rigid3d now = filter->camera().world_from_cam();
+    std::optional<double> error;
+    if (!last_keyframe.empty()) {
+      error = EpipolarDisagreement(camera, last_keyframe, grey, last_keyframe_pose.Inverse() * now, o.features.border,
+                                   o.features.min_distance);
+    }
+    last_keyframe = grey.clone();
+    last_keyframe_pose = now;
+    return error && *error > o.health.max_epipolar_error;
+  }
+
   // Tracking has failed: a non-finite state, or lost_after frames in a row without enough matches.
   bool Lost() const {
     return !filter->covariance().allFinite() || !filter->camera().position.allFinite() ||
@@ -217,6 +238,8 @@ struct Odometry::Impl {
     record.NewFilter();
     frames_without_evidence = 0;
     doubtful_references.clear();  // a new filter names its references afresh
+    last_keyframe = grey.clone();
+    last_keyframe_pose = at.world_from_cam();
     MakeKeyframe(grey, timestamp, priors);
   }
 

@@ -59,6 +59,15 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
                      TwoViewMotion* motion);
 
+// How far the motion `first_from_second` (the filter's between two keyframes; the length of its translation does
+// not matter) is from what the frames themselves show, as a check of the filter: corners of `first` (at least
+// `border` px inside, `min_distance` px apart) tracked into `second` (8-bit grey; pyramidal Lucas-Kanade), those
+// that fit an essential matrix kept, and the median angle (degrees) by which their bearings in `second` miss the
+// epipolar planes of the motion (without translation: the rotated bearings of `first`). Nothing when the tracks
+// cannot tell: fewer than kBootstrapInliers of them fit (or fewer than half).
+std::optional<double> EpipolarDisagreement(const Camera& camera, const cv::Mat& first, const cv::Mat& second,
+                                           const Rigid3d& first_from_second, int border, double min_distance);
+
 // What a successful bootstrap gives the odometry.
 struct BootstrapStart {
   CameraState camera;               // at the current frame: pose, and the mean velocities since the first

@@ -58,8 +58,9 @@ struct PriorOptions {
 // How far a frame's pose can be trusted, from the evidence the filter has (FrameStats::health):
 //   tracked    the update used at least min_inliers matches, at least min_inlier_share of the features searched
 //              for, their mean normalised innovation squared (FrameStats::nis) is at most max_nis (the camera
-//              moved as the motion model allowed: a jump or a stall of the images does not), and the map it
-//              measured against was made from trusted poses;
+//              moved as the motion model allowed: a jump or a stall of the images does not), the map it
+//              measured against was made from trusted poses, and, at a keyframe, its motion since the last one
+//              agrees with the two frames' own geometry (max_epipolar_error);
 //   uncertain  any of these fails; a keyframe made from a pose with too few inliers carries the doubt into its
 //              features: frames whose measurements are mostly of those features are uncertain;
 //   lost       tracking failed at this frame (lost_after frames in a row without enough matches, min_inliers and
@@ -74,12 +75,16 @@ struct HealthOptions {
   int min_inliers = 6;            // matches used in the update
   double min_inlier_share = 0.3;  // of the features searched for
   double max_nis = 2;             // their mean normalised innovation squared (2 expected of a consistent filter)
+  // Degrees: at each keyframe, how far the filter's motion since the last keyframe may miss what the two frames
+  // show (EpipolarDisagreement), at most.
+  double max_epipolar_error = 1;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
     visit("min_inliers", self.min_inliers);
     visit("min_inlier_share", self.min_inlier_share);
     visit("max_nis", self.max_nis);
+    visit("max_epipolar_error", self.max_epipolar_error);
   }
   bool Check() const;
   bool operator==(const HealthOptions&) const = default;
