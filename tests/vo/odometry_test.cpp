@@ -285,6 +285,24 @@ TEST(Odometry, EpipolarDisagreementSeesAWrongMotion) {
   EXPECT_FALSE(EpipolarDisagreement(s.camera, s.grey[40], blank, truth, 10, 12).has_value());
 }
 
+// Features that the motion takes away quickly (every fourth frame of the street: keyframes a few frames apart)
+// are replaced by twice as many with features.fast_turnover; without it the state holds the usual number.
+TEST(Odometry, FastTurnoverKeepsMoreFeatures) {
+  const Street& s = TestStreet();
+  const auto most_points = [&](int fast_turnover) {
+    VoOptions options;
+    options.features.fast_turnover = fast_turnover;
+    Odometry odometry(s.camera, options);
+    int most = 0;
+    for (size_t k = 0; k < s.grey.size(); k += 4)
+      most = std::max(most, odometry.Track(s.grey[k], s.walk[k].timestamp).points);
+    return most;
+  };
+  const int usual = most_points(0), more = most_points(8);
+  EXPECT_LE(usual, 2 * VoOptions().features.new_features);
+  EXPECT_GT(more, usual + VoOptions().features.new_features / 2) << usual;
+}
+
 // The health check (Health): a clean street is tracked throughout; each planted fault in the images is flagged
 // at the frame it happens (frames ahead shown early and late, the same image held, a blank frame), and the track
 // is trusted again after it. Measured (mean normalised innovation squared per match): 0.0-0.3 on the clean

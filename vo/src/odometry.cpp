@@ -87,6 +87,8 @@ struct Odometry::Impl {
   std::set<int> doubtful_references;  // keyframes made from a pose in doubt, while features of theirs remain
   cv::Mat last_keyframe;              // grey, for the two-view check of the next keyframe (MotionDisagrees)
   Rigid3d last_keyframe_pose;         // its world_from_cam in the filter
+  int last_keyframe_frame = 0;        // its index (FollowTurnover)
+  int feature_scale = 1;              // of min_features and new_features (FollowTurnover)
   int segment = 0;
   double adaptation = 1;  // of the motion noise (MotionNoise::max_adaptation)
   int rough_frames = 0;   // in a row whose innovations exceed kNisHigh
@@ -127,7 +129,8 @@ struct Odometry::Impl {
                 &start->corners);
         stats.keyframe = stats.bootstrap = true;
       } else if (static_cast<int>(tracks.Visible(*filter, camera, o.features.border).size()) <
-                 o.features.min_features) {
+                 o.features.min_features * feature_scale) {
+        FollowTurnover();
         const bool disagrees = MotionDisagrees(grey);
         if (disagrees) stats.health = Health::kUncertain;
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
@@ -209,6 +212,19 @@ struct Odometry::Impl {
     last_keyframe = grey.clone();
     last_keyframe_pose = now;
     return error && *error > o.health.max_epipolar_error;
+  }
+
+  // Keyframes closer than features.fast_turnover frames: twice the features, until they are twice as far apart.
+  void FollowTurnover() {
+    const int frame = static_cast<int>(trajectory.size());
+    const int since = frame - last_keyframe_frame;
+    last_keyframe_frame = frame;
+    if (o.features.fast_turnover == 0) return;
+    if (since < o.features.fast_turnover) {
+      feature_scale = 2;
+    } else if (since > 2 * o.features.fast_turnover) {
+      feature_scale = 1;
+    }
   }
 
   // Tracking has failed: a non-finite state, or lost_after frames in a row without enough matches.
@@ -371,8 +387,9 @@ struct Odometry::Impl {
                  cv::Scalar(0), cv::FILLED);
     }
     std::vector<cv::Point2f> found;
-    cv::goodFeaturesToTrack(grey, found, kCornersPerNewFeature * o.features.new_features, kCornerQuality,
-                            o.features.min_distance, mask);
+    const int new_features = o.features.new_features * feature_scale;
+    cv::goodFeaturesToTrack(grey, found, kCornersPerNewFeature * new_features, kCornerQuality, o.features.min_distance,
+                            mask);
     if (found.empty()) return false;
     const std::vector<DepthPrior> known = priors ? *priors : MappedInView();
 
@@ -393,7 +410,7 @@ struct Odometry::Impl {
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
     int points = 0;
     for (Corner& c : keyframe.corners) {
-      if (c.used || points + static_cast<int>(seeds.size()) >= o.features.new_features) continue;
+      if (c.used || points + static_cast<int>(seeds.size()) >= new_features) continue;
       c.used = true;
       ++points;
       const double rho = PriorInverseDepth(known, c.pixel);

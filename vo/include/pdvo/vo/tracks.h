@@ -22,9 +22,12 @@ struct FeatureOptions {
   int max_measurements = 200;  // features searched for per frame, at most
   int min_features = 20;       // fewer in view: a new keyframe
   int new_features = 25;       // features initialised per keyframe, at most
-  double min_distance = 12;    // px between features at initialisation
-  int border = 10;             // px: features nearer the image border leave
-  int max_misses = 3;          // failed searches in a row before a feature leaves
+  // Features that the motion takes away within this many frames (keyframes closer than this, as from a car):
+  // min_features and new_features double until keyframes are twice as far apart again. 0: never.
+  int fast_turnover = 8;
+  double min_distance = 12;  // px between features at initialisation
+  int border = 10;           // px: features nearer the image border leave
+  int max_misses = 3;        // failed searches in a row before a feature leaves
   // A feature also leaves when the robust update has rejected at least min_rejections of its matches and more
   // than max_rejected_share of them (its patch straddles a depth edge or slides on a repetition).
   int min_rejections = 3;
@@ -35,6 +38,7 @@ struct FeatureOptions {
     visit("max_measurements", self.max_measurements);
     visit("min_features", self.min_features);
     visit("new_features", self.new_features);
+    visit("fast_turnover", self.fast_turnover);
     visit("min_distance", self.min_distance);
     visit("border", self.border);
     visit("max_misses", self.max_misses);
