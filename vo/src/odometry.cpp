@@ -4,7 +4,6 @@
 #include <chrono>
 #include <opencv2/imgproc.hpp>
 #include <random>
-#include <set>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
@@ -35,12 +34,6 @@ bool PriorOptions::Check() const {
   return true;
 }
 
-bool HealthOptions::Check() const {
-  PDVO_CHECK_OPTION(min_inliers >= 0 && min_inlier_share >= 0 && min_inlier_share <= 1 && max_nis > 0);
-  PDVO_CHECK_OPTION(max_epipolar_error > 0);
-  return true;
-}
-
 bool VoOptions::Check() const {
   PDVO_CHECK_OPTION(working_width == 0 || (working_width >= 64 && working_width <= kMaxImageSide));
   PDVO_CHECK_OPTION(lost_after >= 1);
@@ -61,7 +54,8 @@ struct Odometry::Impl {
         grower(c, options.planes, options.features, options.prior.inverse_depth_sigma / options.prior.inverse_depth),
         bootstrap(c, options.bootstrap, options.features.border, options.features.min_distance,
                   options.prior.inverse_depth),
-        record(options.planes.min_plane_points) {
+        record(options.planes.min_plane_points),
+        health(c, options.health, options.features.border, options.features.min_distance) {
     if (detector) {
       detections = std::make_unique<DetectionWorker>(std::move(detector), o.pdvo.schedule, o.pdvo.delay_frames,
                                                      o.pdvo.timeout_seconds);
@@ -83,12 +77,9 @@ struct Odometry::Impl {
   int detections_failed = 0;
   double last_time = 0;
   bool started = false;
-  int frames_without_evidence = 0;    // in a row (Evidence)
-  std::set<int> doubtful_references;  // keyframes made from a pose in doubt, while features of theirs remain
-  cv::Mat last_keyframe;              // grey, for the two-view check of the next keyframe (MotionDisagrees)
-  Rigid3d last_keyframe_pose;         // its world_from_cam in the filter
-  int last_keyframe_frame = 0;        // its index (FollowTurnover)
-  int feature_scale = 1;              // of min_features and new_features (FollowTurnover)
+  HealthCheck health;
+  int last_keyframe_frame = 0;  // its index (FollowTurnover)
+  int feature_scale = 1;        // of min_features and new_features (FollowTurnover)
   int segment = 0;
   double adaptation = 1;  // of the motion noise (MotionNoise::max_adaptation)
   int rough_frames = 0;   // in a row whose innovations exceed kNisHigh
@@ -108,10 +99,11 @@ struct Odometry::Impl {
       const RobustUpdateResult update = UpdateRobustly(camera, o.ransac, search.matches, &rng, filter.get());
       Tally(search, update, &stats);
       Adapt(stats);
-      const bool evidence = Evidence(stats);
-      frames_without_evidence = evidence ? 0 : frames_without_evidence + 1;
-      const bool consistent = stats.nis <= o.health.max_nis;
-      stats.health = evidence && consistent && !MostlyFromDoubt(search, update) ? Health::kTracked : Health::kUncertain;
+      const bool evidence = health.Evidence(stats.update, stats.measurements, stats.attempted);
+      std::vector<int> used_references;
+      for (size_t i = 0; i < update.used.size(); ++i)
+        if (update.used[i]) used_references.push_back(search.references[i]);
+      stats.health = health.Judge(evidence, stats.nis, used_references, filter->references());
       tracks.LeaveRejected(o.features, filter.get(), &record);
       grower.Grow(filter.get(), &tracks, &record);
       if (Lost()) {
@@ -131,11 +123,10 @@ struct Odometry::Impl {
       } else if (static_cast<int>(tracks.Visible(*filter, camera, o.features.border).size()) <
                  o.features.min_features * feature_scale) {
         FollowTurnover();
-        const bool disagrees = MotionDisagrees(grey);
-        if (disagrees) stats.health = Health::kUncertain;
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
-        if (stats.keyframe && (!evidence || disagrees))
-          doubtful_references.insert(filter->references().rbegin()->first);
+        const int reference = stats.keyframe ? filter->references().rbegin()->first : -1;
+        if (health.AtKeyframe(grey, filter->camera().world_from_cam(), reference, evidence))
+          stats.health = Health::kUncertain;
       }
     }
     stats.segment = segment;
@@ -193,27 +184,6 @@ struct Odometry::Impl {
     }
   }
 
-  // Enough evidence for the frame's pose (HealthOptions).
-  bool Evidence(const FrameStats& stats) const {
-    return stats.update == UpdateStatus::kOk && stats.measurements >= o.health.min_inliers &&
-           stats.measurements >= o.health.min_inlier_share * stats.attempted;
-  }
-
-  // True if the filter's motion since the last keyframe misses what the two frames show by more than
-  // health.max_epipolar_error (EpipolarDisagreement); false also when the frames cannot tell. This frame becomes
-  // the last keyframe.
-  bool MotionDisagrees(const cv::Mat& grey) {
-    const Rigid3d now = filter->camera().world_from_cam();
-    std::optional<double> error;
-    if (!last_keyframe.empty()) {
-      error = EpipolarDisagreement(camera, last_keyframe, grey, last_keyframe_pose.Inverse() * now, o.features.border,
-                                   o.features.min_distance);
-    }
-    last_keyframe = grey.clone();
-    last_keyframe_pose = now;
-    return error && *error > o.health.max_epipolar_error;
-  }
-
   // Keyframes closer than features.fast_turnover frames: twice the features, until they are twice as far apart.
   void FollowTurnover() {
     const int frame = static_cast<int>(trajectory.size());
@@ -230,7 +200,7 @@ struct Odometry::Impl {
   // Tracking has failed: a non-finite state, or lost_after frames in a row without enough matches.
   bool Lost() const {
     return !filter->covariance().allFinite() || !filter->camera().position.allFinite() ||
-           frames_without_evidence >= o.lost_after;
+           health.frames_without_evidence() >= o.lost_after;
   }
 
   // Starts at rest at `at` with generic priors, and arms the two-view bootstrap.
@@ -252,10 +222,7 @@ struct Odometry::Impl {
     filter = std::make_unique<Filter>(at, Matrix12d(sigma.cwiseAbs2().asDiagonal()));
     tracks = Tracks();
     record.NewFilter();
-    frames_without_evidence = 0;
-    doubtful_references.clear();  // a new filter names its references afresh
-    last_keyframe = grey.clone();
-    last_keyframe_pose = at.world_from_cam();
+    health.Restart(grey, at.world_from_cam());
     MakeKeyframe(grey, timestamp, priors);
   }
 
@@ -263,7 +230,8 @@ struct Odometry::Impl {
   struct Search {
     std::vector<PointMeasurement> matches;
     std::vector<std::pair<History*, size_t>> searched;
-    std::vector<double> nis;  // per match: its normalised innovation squared against the prediction
+    std::vector<double> nis;      // per match: its normalised innovation squared against the prediction
+    std::vector<int> references;  // per match: its feature's reference camera
   };
   // Searches for every feature in view (at most max_measurements): predicts its pixel and innovation
   // covariance, warps its keyframe patch by its plane's homography (a point's: fronto-parallel), and searches by
@@ -287,6 +255,7 @@ struct Odometry::Impl {
       if (matched) {
         out.matches.push_back({id, found, o.search.pixel_sigma, ray});
         out.nis.push_back((found - pixel).dot(s.inverse() * (found - pixel)));
+        out.references.push_back(reference);
         out.searched.emplace_back(history, observations.size());
         history->misses = 0;
       } else {
@@ -333,24 +302,6 @@ struct Odometry::Impl {
       if (update.used[i]) nis += search.nis[i];
     }
     stats->nis = stats->measurements > 0 ? nis / stats->measurements : 0;
-  }
-
-  // True if most of the frame's used measurements are of features whose keyframe was made from a pose in doubt:
-  // then the pose is measured against a map that is itself in doubt.
-  bool MostlyFromDoubt(const Search& search, const RobustUpdateResult& update) {
-    std::erase_if(doubtful_references, [&](int r) { return !filter->references().contains(r); });
-    if (doubtful_references.empty()) return false;
-    int doubtful = 0, used = 0;
-    for (size_t i = 0; i < update.used.size(); ++i) {
-      if (!update.used[i]) continue;
-      const int id = search.matches[i].point;
-      const auto point = filter->points().find(id);
-      const int reference =
-          point != filter->points().end() ? point->second.reference : filter->planes().at(id).reference;
-      doubtful += doubtful_references.contains(reference);
-      ++used;
-    }
-    return 2 * doubtful > used;
   }
 
   // The mapped points as the current camera sees them: pixel and inverse distance.

@@ -25,6 +25,7 @@
 #include "pdvo/vo/bootstrap.h"
 #include "pdvo/vo/detection_worker.h"
 #include "pdvo/vo/filter.h"
+#include "pdvo/vo/health.h"
 #include "pdvo/vo/map.h"
 #include "pdvo/vo/patch.h"
 #include "pdvo/vo/plane_growing.h"
@@ -53,41 +54,6 @@ struct PriorOptions {
   }
   bool Check() const;
   bool operator==(const PriorOptions&) const = default;
-};
-
-// How far a frame's pose can be trusted, from the evidence the filter has (FrameStats::health):
-//   tracked    the update used at least min_inliers matches, at least min_inlier_share of the features searched
-//              for, their mean normalised innovation squared (FrameStats::nis) is at most max_nis (the camera
-//              moved as the motion model allowed: a jump or a stall of the images does not), the map it
-//              measured against was made from trusted poses, and, at a keyframe, its motion since the last one
-//              agrees with the two frames' own geometry (max_epipolar_error);
-//   uncertain  any of these fails; a keyframe made from a pose with too few inliers carries the doubt into its
-//              features: frames whose measurements are mostly of those features are uncertain;
-//   lost       tracking failed at this frame (lost_after frames in a row without enough matches, min_inliers and
-//              min_inlier_share, or a non-finite state) and started again: a new segment.
-// A segment is the frames between two starts: monocular odometry cannot relate one segment's poses to another's
-// (scale and pose start afresh), so they are compared with ground truth each on its own (pdvo ate --health).
-enum class Health { kTracked, kUncertain, kLost };
-constexpr std::array<std::pair<Health, const char*>, 3> OptionNames(Health) {
-  return {{{Health::kTracked, "tracked"}, {Health::kUncertain, "uncertain"}, {Health::kLost, "lost"}}};
-}
-struct HealthOptions {
-  int min_inliers = 6;            // matches used in the update
-  double min_inlier_share = 0.3;  // of the features searched for
-  double max_nis = 2;             // their mean normalised innovation squared (2 expected of a consistent filter)
-  // Degrees: at each keyframe, how far the filter's motion since the last keyframe may miss what the two frames
-  // show (EpipolarDisagreement), at most.
-  double max_epipolar_error = 1;
-
-  template <class Self, class V>
-  static void Fields(Self& self, V& visit) {
-    visit("min_inliers", self.min_inliers);
-    visit("min_inlier_share", self.min_inlier_share);
-    visit("max_nis", self.max_nis);
-    visit("max_epipolar_error", self.max_epipolar_error);
-  }
-  bool Check() const;
-  bool operator==(const HealthOptions&) const = default;
 };
 
 // Every option of the odometry; vo/config/default.yaml lists them with their defaults.
