@@ -33,9 +33,11 @@ run() {
   $pdvo ate --est "$out/trajectory.txt" "${ate_args[@]}" -v warning >"$out.ate" 2>&1 \
     || { echo "vo_real: pdvo ate failed on $name ($mode):" >&2; cat "$out.ate" >&2; exit 1; }
   local health
-  health=$(python3 -c 'import json,sys,collections
-f=json.load(open(sys.argv[1]))["frames"]; c=collections.Counter(x["health"] for x in f)
-print("%d tracked, %d uncertain, %d lost" % (c["tracked"], c["uncertain"], c["lost"]))' "$out/stats.json")
+  local count health=""
+  for state in tracked uncertain lost; do  # stats.json has one line per frame; health is one of these per frame
+    count=$({ grep -o "\"health\": *\"$state\"" "$out/stats.json" || true; } | wc -l)
+    health+="${health:+, }$count $state"
+  done
   awk -v name="$name" -v mode="$mode" -v health="$health" '
     /^ATE translation/ { t = $4 } /^ATE rotation/ { r = $4; rmax = $10 }
     /^trusted poses/ { sub(":", "", $5); trusted = sprintf(", trusted %s of %s, max rotation error %s deg", $3, $5, "RMAX") }
