@@ -126,7 +126,7 @@ std::optional<double> EpipolarDisagreement(const Camera& camera, const cv::Mat& 
   cv::Mat inliers;
   const cv::Mat e = cv::findEssentialMat(from, to, camera.K(), cv::RANSAC, kCheckConfidence, kRansacThreshold, inliers);
   if (e.rows != 3 || e.cols != 3) return std::nullopt;
-  const Eigen::Matrix3d& rotation = first_from_second.rotation.toRotationMatrix();
+  const Eigen::Matrix3d rotation = first_from_second.rotation.toRotationMatrix();
   const Eigen::Vector3d& baseline = first_from_second.translation;
   std::vector<double> angles;
   for (int i = 0; i < inliers.rows; ++i) {
