@@ -62,8 +62,9 @@ TEST(Filter, PointJacobianMatchesCentralDifferencesOverTheWholeState) {
   const Filter f = BusyFilter();
   for (const auto& [id, point] : f.points()) {
     Eigen::Vector2d pixel;
-    Eigen::MatrixXd j;
-    ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, &j));
+    MeasurementJacobian sparse;
+    ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, &sparse));
+    const Eigen::MatrixXd j = sparse.Dense(f.size());
     const Eigen::MatrixXd numeric = NumericJacobian(f, [id = id](const Filter& g) {
       Eigen::Vector2d p;
       EXPECT_TRUE(g.PredictPoint(kCamera, id, &p, nullptr));
@@ -80,8 +81,9 @@ TEST(Filter, PlanePointJacobianMatchesCentralDifferencesOverTheWholeState) {
   for (const Eigen::Vector2d& keyframe_pixel : {Eigen::Vector2d(100, 80), Eigen::Vector2d(220, 170)}) {
     const Eigen::Vector3d ray = kCamera.Ray(keyframe_pixel);
     Eigen::Vector2d pixel;
-    Eigen::MatrixXd j;
-    ASSERT_TRUE(f.PredictPlanePoint(kCamera, id, ray, &pixel, &j));
+    MeasurementJacobian sparse;
+    ASSERT_TRUE(f.PredictPlanePoint(kCamera, id, ray, &pixel, &sparse));
+    const Eigen::MatrixXd j = sparse.Dense(f.size());
     const Eigen::MatrixXd numeric = NumericJacobian(f, [&](const Filter& g) {
       Eigen::Vector2d p;
       EXPECT_TRUE(g.PredictPlanePoint(kCamera, id, ray, &p, nullptr));
@@ -255,6 +257,43 @@ TEST(Filter, RemovingPointsKeepsTheRestOfTheCovariance) {
   EXPECT_EQ(f.references().begin()->second.offset, 12);
   for (const auto& [id, p] : f.points()) EXPECT_EQ(f.covariance()(p.offset, p.offset), variance_before[id]);
   EXPECT_THROW(f.RemovePoint(anchored_first[0]), InvalidArgument);
+}
+
+// Removing several points at once leaves the same filter as removing them one by one.
+TEST(Filter, RemovingPointsAtOnceEqualsOneByOne) {
+  Filter one_by_one = BusyFilter(), at_once = BusyFilter();
+  for (Filter* f : {&one_by_one, &at_once}) f->RemovePlane(f->planes().begin()->first);
+  std::vector<int> ids;
+  for (const auto& [id, p] : at_once.points()) ids.push_back(id);
+  ids.erase(ids.begin() + 3);  // all but one of the second reference's: the first reference goes
+  for (int id : ids) one_by_one.RemovePoint(id);
+  at_once.RemovePoints(ids);
+  EXPECT_EQ(at_once.size(), 12 + 6 + 1);
+  EXPECT_EQ(at_once.references().size(), 1u);
+  EXPECT_EQ(at_once.size(), one_by_one.size());
+  EXPECT_EQ(at_once.covariance(), one_by_one.covariance());
+  EXPECT_THROW(at_once.RemovePoints({ids[0]}), InvalidArgument);
+}
+
+// The sparse Jacobian's products with the covariance equal the dense matrix's, for points and plane points.
+TEST(Filter, SparseJacobianProductsEqualTheDenseOnes) {
+  const Filter f = BusyFilter();
+  const Eigen::MatrixXd& p = f.covariance();
+  std::vector<MeasurementJacobian> jacobians;
+  Eigen::Vector2d pixel;
+  for (const auto& [id, point] : f.points()) {
+    ASSERT_TRUE(f.PredictPoint(kCamera, id, &pixel, &jacobians.emplace_back()));
+  }
+  ASSERT_TRUE(f.PredictPlanePoint(kCamera, f.planes().begin()->first, kCamera.Ray({150, 110}), &pixel,
+                                  &jacobians.emplace_back()));
+  const Eigen::MatrixXd x = Eigen::MatrixXd::Random(f.size(), 3);
+  for (const MeasurementJacobian& j : jacobians) {
+    const Eigen::MatrixXd dense = j.Dense(f.size());
+    EXPECT_EQ((dense.array() != 0).count(), 2 * (12 + j.feature_size));  // pose, reference, feature
+    EXPECT_LT((j.CovarianceTimesTranspose(p) - p * dense.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((j.Propagate(p) - dense * p * dense.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((j.Times(x) - dense * x).cwiseAbs().maxCoeff(), 1e-12);
+  }
 }
 
 // The truth: a camera moving at constant velocity (1 m/s sideways and forwards, turning slowly) past points

@@ -19,6 +19,37 @@ const char* ToString(UpdateStatus status) {
   return "?";
 }
 
+Eigen::MatrixXd MeasurementJacobian::Dense(int size) const {
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(2, size);
+  j.leftCols<6>() = camera;
+  j.middleCols<6>(reference_offset) += reference;
+  j.middleCols(feature_offset, feature_size) += feature.leftCols(feature_size);
+  return j;
+}
+
+Eigen::Matrix<double, Eigen::Dynamic, 2> MeasurementJacobian::CovarianceTimesTranspose(const Eigen::MatrixXd& p) const {
+  return p.leftCols<6>() * camera.transpose() + p.middleCols<6>(reference_offset) * reference.transpose() +
+         p.middleCols(feature_offset, feature_size) * feature.leftCols(feature_size).transpose();
+}
+
+Eigen::Matrix<double, 2, Eigen::Dynamic> MeasurementJacobian::Times(const Eigen::MatrixXd& x) const {
+  return camera * x.topRows<6>() + reference * x.middleRows<6>(reference_offset) +
+         feature.leftCols(feature_size) * x.middleRows(feature_offset, feature_size);
+}
+
+Eigen::Matrix2d MeasurementJacobian::Propagate(const Eigen::MatrixXd& p) const {
+  // The blocks of P that the three column blocks meet: nine small products.
+  const int offsets[3] = {0, reference_offset, feature_offset}, sizes[3] = {6, 6, feature_size};
+  const Eigen::Matrix<double, 2, Eigen::Dynamic> blocks[3] = {camera, reference, feature.leftCols(feature_size)};
+  Eigen::Matrix2d out = Eigen::Matrix2d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      out += blocks[a] * p.block(offsets[a], offsets[b], sizes[a], sizes[b]) * blocks[b].transpose();
+    }
+  }
+  return out;
+}
+
 Filter::Filter(const CameraState& camera, const Matrix12d& covariance) : camera_(camera), covariance_(covariance) {}
 
 void Filter::Predict(double dt, const MotionNoise& noise) {
@@ -60,16 +91,24 @@ void Filter::Augment(const Eigen::VectorXd& variances) {
   covariance_.bottomRightCorner(k, k).diagonal() = variances;
 }
 
-int Filter::AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho) {
+std::vector<int> Filter::AddPoints(int reference, const std::vector<NewPoint>& points) {
   auto r = references_.find(reference);
   PDVO_THROW_CHECK(r != references_.end(), InvalidArgument, "filter: no reference camera " << reference);
-  PDVO_THROW_CHECK(sigma_rho > 0 && std::isfinite(rho), InvalidArgument, "filter: bad inverse depth prior");
+  Eigen::VectorXd variances(points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    PDVO_THROW_CHECK(points[k].sigma_rho > 0 && std::isfinite(points[k].rho), InvalidArgument,
+                     "filter: bad inverse depth prior");
+    variances[k] = points[k].sigma_rho * points[k].sigma_rho;
+  }
   const int offset = size();
-  Augment(Eigen::VectorXd::Constant(1, sigma_rho * sigma_rho));
-  ++r->second.users;
-  const int id = next_id_++;
-  points_[id] = {reference, ray.normalized(), rho, offset};
-  return id;
+  Augment(variances);
+  std::vector<int> ids;
+  for (size_t k = 0; k < points.size(); ++k) {
+    ++r->second.users;
+    ids.push_back(next_id_++);
+    points_[ids.back()] = {reference, points[k].ray.normalized(), points[k].rho, offset + static_cast<int>(k)};
+  }
+  return ids;
 }
 
 int Filter::AddPlane(int reference, const InversePlane& plane, double sigma_normal, double sigma_inverse_distance) {
@@ -88,13 +127,17 @@ int Filter::AddPlane(int reference, const InversePlane& plane, double sigma_norm
   return id;
 }
 
-void Filter::RemovePoint(int id) {
-  auto p = points_.find(id);
-  PDVO_THROW_CHECK(p != points_.end(), InvalidArgument, "filter: no point " << id);
-  const std::vector<int> dropped = {p->second.offset};
-  const int reference = p->second.reference;
-  points_.erase(p);
-  Remove(dropped, reference);
+void Filter::RemovePoints(const std::vector<int>& ids) {
+  if (ids.empty()) return;
+  std::vector<int> dropped, references;
+  for (int id : ids) {
+    auto p = points_.find(id);
+    PDVO_THROW_CHECK(p != points_.end(), InvalidArgument, "filter: no point " << id);
+    dropped.push_back(p->second.offset);
+    references.push_back(p->second.reference);
+    points_.erase(p);
+  }
+  Remove(std::move(dropped), references);
 }
 
 void Filter::RemovePlane(int id) {
@@ -104,18 +147,22 @@ void Filter::RemovePlane(int id) {
   const std::vector<int> dropped = {o, o + 1, o + 2, o + 3};
   const int reference = p->second.reference;
   planes_.erase(p);
-  Remove(dropped, reference);
+  Remove(dropped, {reference});
 }
 
-void Filter::Remove(std::vector<int> dropped, int reference) {
-  auto r = references_.find(reference);
-  if (--r->second.users == 0) {
-    for (int k = 0; k < 6; ++k) dropped.push_back(r->second.offset + k);
-    references_.erase(r);
+void Filter::Remove(std::vector<int> dropped, const std::vector<int>& references) {
+  for (int reference : references) {
+    auto r = references_.find(reference);
+    if (--r->second.users == 0) {
+      for (int k = 0; k < 6; ++k) dropped.push_back(r->second.offset + k);
+      references_.erase(r);
+    }
   }
+  std::vector<bool> drop(size(), false);
+  for (int i : dropped) drop[i] = true;
   std::vector<int> keep;
   for (int i = 0; i < size(); ++i) {
-    if (std::find(dropped.begin(), dropped.end(), i) == dropped.end()) keep.push_back(i);
+    if (!drop[i]) keep.push_back(i);
   }
   covariance_ = Eigen::MatrixXd(covariance_(keep, keep));
   Renumber();
@@ -150,13 +197,16 @@ UpdateStatus Filter::MergePointIntoPlane(int point_id, int plane_id, double sigm
   PDVO_THROW_CHECK(p.reference == q.reference, InvalidArgument,
                    "filter: point " << point_id << " and plane " << plane_id << " have different reference cameras");
   // r = rho_point - rho_plane(ray), measured as 0.
-  Linearised l;
-  l.h = Eigen::MatrixXd::Zero(1, size());
-  l.h(0, p.offset) = 1;
-  l.h.block<1, 4>(0, q.offset) = -q.plane.InverseDepthJacobian(p.ray);
-  l.innovation = Eigen::VectorXd::Constant(1, q.plane.InverseDepthAlong(p.ray) - p.inverse_depth);
-  l.noise = Eigen::VectorXd::Constant(1, sigma * sigma);
-  const UpdateResult fused = Correct(l);
+  Eigen::RowVectorXd h = Eigen::RowVectorXd::Zero(size());
+  h[p.offset] = 1;
+  h.segment<4>(q.offset) = -q.plane.InverseDepthJacobian(p.ray);
+  Eigen::MatrixXd ph_t = covariance_ * h.transpose();
+  const Eigen::MatrixXd s = h * ph_t + Eigen::MatrixXd::Constant(1, 1, sigma * sigma);
+  Gain g;
+  const UpdateStatus status = ComputeGain(std::move(ph_t), s, &g);
+  if (status != UpdateStatus::kOk) return status;
+  const UpdateResult fused =
+      Correct(g, Eigen::VectorXd::Constant(1, q.plane.InverseDepthAlong(p.ray) - p.inverse_depth));
   if (fused.ok()) RemovePoint(point_id);
   return fused.status;
 }
@@ -180,7 +230,7 @@ void Filter::Renumber() {
   }
 }
 
-bool Filter::PredictPoint(const Camera& camera, int id, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const {
+bool Filter::PredictPoint(const Camera& camera, int id, Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const {
   const Point& p = points_.at(id);
   const Reference& r = references_.at(p.reference);
   ProjectionJacobians j;
@@ -189,16 +239,18 @@ bool Filter::PredictPoint(const Camera& camera, int id, Eigen::Vector2d* pixel, 
     return false;
   }
   if (jacobian) {
-    jacobian->setZero(2, size());
-    jacobian->leftCols<6>() = j.current;
-    jacobian->middleCols<6>(r.offset) = j.reference;
-    jacobian->col(p.offset) = j.inverse_depth;
+    jacobian->camera = j.current;
+    jacobian->reference = j.reference;
+    jacobian->feature.col(0) = j.inverse_depth;
+    jacobian->reference_offset = r.offset;
+    jacobian->feature_offset = p.offset;
+    jacobian->feature_size = 1;
   }
   return true;
 }
 
 bool Filter::PredictPlanePoint(const Camera& camera, int id, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
-                               Eigen::MatrixXd* jacobian) const {
+                               MeasurementJacobian* jacobian) const {
   const Plane& p = planes_.at(id);
   const Reference& r = references_.at(p.reference);
   ProjectionJacobians j;
@@ -208,16 +260,18 @@ bool Filter::PredictPlanePoint(const Camera& camera, int id, const Eigen::Vector
     return false;
   }
   if (jacobian) {
-    jacobian->setZero(2, size());
-    jacobian->leftCols<6>() = j.current;
-    jacobian->middleCols<6>(r.offset) = j.reference;
-    jacobian->middleCols<4>(p.offset) = jp;
+    jacobian->camera = j.current;
+    jacobian->reference = j.reference;
+    jacobian->feature = jp;
+    jacobian->reference_offset = r.offset;
+    jacobian->feature_offset = p.offset;
+    jacobian->feature_size = 4;
   }
   return true;
 }
 
 bool Filter::PredictMeasurement(const Camera& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
-                                Eigen::MatrixXd* jacobian) const {
+                                MeasurementJacobian* jacobian) const {
   return planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
                                 : PredictPoint(camera, z.point, pixel, jacobian);
 }
@@ -225,37 +279,46 @@ bool Filter::PredictMeasurement(const Camera& camera, const PointMeasurement& z,
 UpdateStatus Filter::Linearise(const Camera& camera, const std::vector<PointMeasurement>& measurements,
                                Linearised* l) const {
   if (measurements.empty()) return UpdateStatus::kNoMeasurements;
-  const int m = 2 * static_cast<int>(measurements.size()), n = size();
-  l->h.resize(m, n);
+  const int m = 2 * static_cast<int>(measurements.size());
+  l->jacobians.resize(measurements.size());
   l->innovation.resize(m);
   l->noise.resize(m);
   for (size_t k = 0; k < measurements.size(); ++k) {
     Eigen::Vector2d predicted;
-    Eigen::MatrixXd jk;
     const PointMeasurement& z = measurements[k];
-    if (!PredictMeasurement(camera, z, &predicted, &jk)) return UpdateStatus::kNotInFront;
-    l->h.middleRows<2>(2 * k) = jk;
-    l->innovation.segment<2>(2 * k) = measurements[k].pixel - predicted;
-    l->noise.segment<2>(2 * k).setConstant(measurements[k].sigma * measurements[k].sigma);
+    if (!PredictMeasurement(camera, z, &predicted, &l->jacobians[k])) return UpdateStatus::kNotInFront;
+    l->innovation.segment<2>(2 * k) = z.pixel - predicted;
+    l->noise.segment<2>(2 * k).setConstant(z.sigma * z.sigma);
   }
   return l->innovation.allFinite() ? UpdateStatus::kOk : UpdateStatus::kNonFinite;
 }
 
-UpdateStatus Filter::ComputeGain(const Eigen::MatrixXd& h, const Eigen::VectorXd& noise, Gain* g) const {
-  g->ph_t = covariance_ * h.transpose();
-  Eigen::MatrixXd s = h * g->ph_t;
-  s.diagonal() += noise;
+UpdateStatus Filter::ComputeGain(const Linearised& l, Gain* g) const {
+  const int m = static_cast<int>(l.innovation.size());
+  Eigen::MatrixXd ph_t(size(), m);
+  for (size_t k = 0; k < l.jacobians.size(); ++k) {
+    ph_t.middleCols<2>(2 * k) = l.jacobians[k].CovarianceTimesTranspose(covariance_);
+  }
+  Eigen::MatrixXd s(m, m);
+  for (size_t k = 0; k < l.jacobians.size(); ++k) s.middleRows<2>(2 * k) = l.jacobians[k].Times(ph_t);
+  s.diagonal() += l.noise;
+  return ComputeGain(std::move(ph_t), s, g);
+}
+
+UpdateStatus Filter::ComputeGain(Eigen::MatrixXd ph_t, const Eigen::MatrixXd& s, Gain* g) {
   g->llt.compute(s);
   if (g->llt.info() != Eigen::Success) return UpdateStatus::kNotPositive;
-  g->gain_t = g->llt.solve(g->ph_t.transpose());  // K^T = S^-1 H P
+  g->ph_t = std::move(ph_t);
   return UpdateStatus::kOk;
 }
 
 UpdateResult Filter::Update(const Camera& camera, const std::vector<PointMeasurement>& measurements) {
   Linearised l;
-  const UpdateStatus status = Linearise(camera, measurements, &l);
+  Gain g;
+  UpdateStatus status = Linearise(camera, measurements, &l);
+  if (status == UpdateStatus::kOk) status = ComputeGain(l, &g);
   if (status != UpdateStatus::kOk) return {status, 0};
-  return Correct(l);
+  return Correct(g, l.innovation);
 }
 
 UpdateStatus Filter::Step(const Camera& camera, const std::vector<PointMeasurement>& measurements,
@@ -263,25 +326,25 @@ UpdateStatus Filter::Step(const Camera& camera, const std::vector<PointMeasureme
   Linearised l;
   Gain g;
   UpdateStatus status = Linearise(camera, measurements, &l);
-  if (status == UpdateStatus::kOk) status = ComputeGain(l.h, l.noise, &g);
+  if (status == UpdateStatus::kOk) status = ComputeGain(l, &g);
   if (status != UpdateStatus::kOk) return status;
-  Eigen::VectorXd delta = g.gain_t.transpose() * l.innovation;
+  Eigen::VectorXd delta = g.ph_t * g.llt.solve(l.innovation);
   if (!delta.allFinite()) return UpdateStatus::kNonFinite;
   *step = std::move(delta);
   return UpdateStatus::kOk;
 }
 
-UpdateResult Filter::Correct(const Linearised& l) {
-  Gain g;
-  const UpdateStatus status = ComputeGain(l.h, l.noise, &g);
-  if (status != UpdateStatus::kOk) return {status, 0};
-  const double nis = l.innovation.dot(g.llt.solve(l.innovation));
-  const Eigen::VectorXd delta = g.gain_t.transpose() * l.innovation;
+UpdateResult Filter::Correct(const Gain& g, const Eigen::VectorXd& innovation) {
+  // With S = L L^T and W = L^-1 H P: K innovation = W^T L^-1 innovation and K H P = W^T W, a symmetric rank
+  // update that costs half the product and keeps P exactly symmetric.
+  const Eigen::VectorXd whitened = g.llt.matrixL().solve(innovation);
+  const Eigen::MatrixXd w = g.llt.matrixL().solve(g.ph_t.transpose());
+  const Eigen::VectorXd delta = w.transpose() * whitened;
   if (!delta.allFinite()) return {UpdateStatus::kNonFinite, 0};
   Apply(delta);
-  covariance_ -= g.ph_t * g.gain_t;  // P - K H P
-  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
-  return {UpdateStatus::kOk, nis};
+  covariance_.selfadjointView<Eigen::Lower>().rankUpdate(w.transpose(), -1);
+  covariance_.triangularView<Eigen::StrictlyUpper>() = covariance_.transpose();
+  return {UpdateStatus::kOk, whitened.squaredNorm()};
 }
 
 void Filter::PredictAfter(const Camera& camera, const std::vector<PointMeasurement>& measurements,

@@ -241,12 +241,12 @@ struct Odometry::Impl {
     const cv::Size size(camera.width, camera.height);
     Search out;
     Eigen::Vector2d pixel;
-    Eigen::MatrixXd jacobian;
+    MeasurementJacobian jacobian;
     auto search = [&](int id, int plane, const Eigen::Vector3d& ray, int reference, const Eigen::Matrix3d& h,
                       const Eigen::Vector2d& keyframe_pixel, History* history) {
       ++stats->attempted;
       const Keyframe& keyframe = tracks.keyframes.at(reference);
-      Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
+      Eigen::Matrix2d s = jacobian.Propagate(filter->covariance());
       s.diagonal().array() += o.search.pixel_sigma * o.search.pixel_sigma;
       cv::Mat patch;
       Eigen::Vector2d found;
@@ -359,14 +359,17 @@ struct Odometry::Impl {
       tracks.planes[id].members.push_back({corner.pixel, camera.Ray(corner.pixel), {}});
     }
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
-    int points = 0;
+    std::vector<Filter::NewPoint> points;
+    std::vector<Eigen::Vector2d> pixels;
     for (Corner& c : keyframe.corners) {
-      if (c.used || points + static_cast<int>(seeds.size()) >= new_features) continue;
+      if (c.used || static_cast<int>(points.size() + seeds.size()) >= new_features) continue;
       c.used = true;
-      ++points;
       const double rho = PriorInverseDepth(known, c.pixel);
-      tracks.points[filter->AddPoint(reference, camera.Ray(c.pixel), rho, PriorSigma(rho))] = {c.pixel, {}};
+      points.push_back({camera.Ray(c.pixel), rho, PriorSigma(rho)});
+      pixels.push_back(c.pixel);
     }
+    const std::vector<int> ids = filter->AddPoints(reference, points);
+    for (size_t k = 0; k < ids.size(); ++k) tracks.points[ids[k]] = {pixels[k], {}};
     return true;
   }
 };

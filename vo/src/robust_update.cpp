@@ -57,9 +57,9 @@ RobustUpdateResult UpdateRobustly(const Camera& camera, const RansacOptions& o,
   std::vector<bool> rescued(all.size(), false);
   for (size_t i = 0; i < all.size(); ++i) {
     Eigen::Vector2d pixel;
-    Eigen::MatrixXd jacobian;
+    MeasurementJacobian jacobian;
     if (best[i] || !filter->PredictMeasurement(camera, all[i], &pixel, &jacobian)) continue;
-    Eigen::Matrix2d s = jacobian * filter->covariance() * jacobian.transpose();
+    Eigen::Matrix2d s = jacobian.Propagate(filter->covariance());
     s.diagonal().array() += all[i].sigma * all[i].sigma;
     const Eigen::Vector2d v = all[i].pixel - pixel;
     rescued[i] = v.dot(s.ldlt().solve(v)) < kRescueGate;

@@ -56,12 +56,17 @@ int Tracks::PlanePoints() const {
   return n;
 }
 
-void Tracks::RemovePoint(int id, Filter* filter, MapRecord* record) {
-  record->KeepPoint(*filter, id);
-  const int reference = filter->points().at(id).reference;
-  filter->RemovePoint(id);
-  points.erase(id);
-  if (!filter->references().count(reference)) keyframes.erase(reference);
+void Tracks::RemovePoints(const std::vector<int>& ids, Filter* filter, MapRecord* record) {
+  std::vector<int> references;
+  for (int id : ids) {
+    record->KeepPoint(*filter, id);
+    references.push_back(filter->points().at(id).reference);
+  }
+  filter->RemovePoints(ids);
+  for (int id : ids) points.erase(id);
+  for (int reference : references) {
+    if (!filter->references().count(reference)) keyframes.erase(reference);
+  }
 }
 
 void Tracks::RemovePlane(int id, Filter* filter, MapRecord* record) {
@@ -79,7 +84,7 @@ void Tracks::LeaveView(const Camera& camera, int border, Filter* filter, MapReco
   for (const auto& [id, p] : filter->points()) {
     if (!filter->PredictPoint(camera, id, &pixel, nullptr) || !Inside(pixel, size, border)) gone.push_back(id);
   }
-  for (int id : gone) RemovePoint(id, filter, record);
+  RemovePoints(gone, filter, record);
   gone.clear();
   for (const auto& [id, t] : planes) {
     const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
@@ -98,7 +103,7 @@ void Tracks::LeaveRejected(const FeatureOptions& options, Filter* filter, MapRec
   for (const auto& [id, t] : points) {
     if (Gone(t.history, options)) bad.push_back(id);
   }
-  for (int id : bad) RemovePoint(id, filter, record);
+  RemovePoints(bad, filter, record);
 }
 
 }  // namespace pdvo::vo

@@ -41,6 +41,25 @@ struct PointMeasurement {
   Eigen::Vector3d ray = Eigen::Vector3d::Zero();  // planes: the measured point's ray (unit, reference frame)
 };
 
+// A measurement's Jacobian with respect to the error state (2 x Filter::size()), kept as its only non-zero
+// blocks: the current camera's pose (columns 0-5), the feature's reference camera (6 columns at its offset) and
+// the feature itself (a point's inverse depth: 1 column; a plane: 4). Products with the covariance then cost
+// O(size) instead of O(size^2).
+struct MeasurementJacobian {
+  Eigen::Matrix<double, 2, 6> camera = Eigen::Matrix<double, 2, 6>::Zero();
+  Eigen::Matrix<double, 2, 6> reference = Eigen::Matrix<double, 2, 6>::Zero();
+  Eigen::Matrix<double, 2, 4> feature = Eigen::Matrix<double, 2, 4>::Zero();  // its first feature_size columns
+  int reference_offset = 0, feature_offset = 0, feature_size = 1;
+
+  Eigen::MatrixXd Dense(int size) const;  // the 2 x size matrix
+  // P J^T (size x 2) for a covariance P.
+  Eigen::Matrix<double, Eigen::Dynamic, 2> CovarianceTimesTranspose(const Eigen::MatrixXd& p) const;
+  // J P J^T: the predicted pixel's covariance.
+  Eigen::Matrix2d Propagate(const Eigen::MatrixXd& p) const;
+  // J X for X with size() rows (e.g. P H^T of several measurements: then their rows of H P H^T).
+  Eigen::Matrix<double, 2, Eigen::Dynamic> Times(const Eigen::MatrixXd& x) const;
+};
+
 class Filter {
  public:
   struct Reference {
@@ -77,13 +96,22 @@ class Filter {
   // (no variance, no correlation), so no update moves it: the map's frame is fixed again at each keyframe, as
   // the first camera's is at the start (docs/odometry.md says why).
   int AddReference(bool fixed);
-  // A point on the ray (unit, reference frame) at inverse depth rho with standard deviation sigma_rho,
-  // uncorrelated with the rest of the state.
-  int AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho);
+  // A point on the ray (reference frame) at inverse depth rho with standard deviation sigma_rho, uncorrelated
+  // with the rest of the state. Adding several at once grows the covariance once. Returns the ids.
+  struct NewPoint {
+    Eigen::Vector3d ray;
+    double rho = 0, sigma_rho = 0;
+  };
+  std::vector<int> AddPoints(int reference, const std::vector<NewPoint>& points);
+  int AddPoint(int reference, const Eigen::Vector3d& ray, double rho, double sigma_rho) {
+    return AddPoints(reference, {{ray, rho, sigma_rho}}).front();
+  }
   // A plane with independent standard deviations for each normal component and its inverse distance.
   int AddPlane(int reference, const InversePlane& plane, double sigma_normal, double sigma_inverse_distance);
-  // Removes a point or a plane; a reference camera goes when its last feature does.
-  void RemovePoint(int point);
+  // Removes points or a plane; a reference camera goes when its last feature does. Removing several points at
+  // once copies the covariance once.
+  void RemovePoint(int point) { RemovePoints({point}); }
+  void RemovePoints(const std::vector<int>& points);
   void RemovePlane(int plane);
   // A plane that could not grow becomes a point on `ray` (unit, reference frame): the point's inverse depth is
   // where the ray meets the plane, with the covariance that follows (first order). Returns the point's id.
@@ -96,14 +124,14 @@ class Filter {
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.
-  bool PredictPoint(const Camera& camera, int point, Eigen::Vector2d* pixel, Eigen::MatrixXd* jacobian) const;
+  bool PredictPoint(const Camera& camera, int point, Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const;
   // The same for the point of a plane on `ray`; false also if the ray does not meet the plane in front.
   bool PredictPlanePoint(const Camera& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
-                         Eigen::MatrixXd* jacobian) const;
+                         MeasurementJacobian* jacobian) const;
 
   // The predicted pixel of a measurement's feature (a point, or the plane point on its ray), as above.
   bool PredictMeasurement(const Camera& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
-                          Eigen::MatrixXd* jacobian) const;
+                          MeasurementJacobian* jacobian) const;
 
   // One batched EKF update with the measurements (their features must exist).
   UpdateResult Update(const Camera& camera, const std::vector<PointMeasurement>& measurements);
@@ -122,22 +150,26 @@ class Filter {
   void Apply(const Eigen::VectorXd& delta);
 
  private:
-  // The stacked Jacobian (2 count x size()), innovation (measured - predicted) and noise variances.
+  // The measurements' Jacobians, their stacked innovation (measured - predicted) and noise variances.
   struct Linearised {
-    Eigen::MatrixXd h;
+    std::vector<MeasurementJacobian> jacobians;
     Eigen::VectorXd innovation, noise;
   };
   UpdateStatus Linearise(const Camera& camera, const std::vector<PointMeasurement>& measurements,
                          Linearised* out) const;
-  // The Kalman gain's parts for Jacobian `h` and noise variances: P H^T and K^T = S^-1 H P, with S's factor.
+  // The Kalman gain's parts: P H^T and the Cholesky factor of the innovation covariance S = H P H^T + R.
   struct Gain {
-    Eigen::MatrixXd ph_t, gain_t;
+    Eigen::MatrixXd ph_t;
     Eigen::LLT<Eigen::MatrixXd> llt;
   };
-  UpdateStatus ComputeGain(const Eigen::MatrixXd& h, const Eigen::VectorXd& noise, Gain* gain) const;
-  // The EKF correction with a linearisation: the state moves by K innovation and P becomes P - K H P.
-  UpdateResult Correct(const Linearised& l);
-  void Remove(std::vector<int> dropped, int reference);
+  UpdateStatus ComputeGain(const Linearised& l, Gain* gain) const;
+  // The same from P H^T and S.
+  static UpdateStatus ComputeGain(Eigen::MatrixXd ph_t, const Eigen::MatrixXd& s, Gain* gain);
+  // The EKF correction: the state moves by K innovation and P becomes P - K H P.
+  UpdateResult Correct(const Gain& gain, const Eigen::VectorXd& innovation);
+  // Drops the error-state indices `dropped` and, of `references` (one entry per removed feature), those left
+  // without users.
+  void Remove(std::vector<int> dropped, const std::vector<int>& references);
   void Renumber();
   // Grows the covariance by variances.size() rows and columns, zero but for `variances` on the new diagonal.
   void Augment(const Eigen::VectorXd& variances);

@@ -124,9 +124,9 @@ struct Tracks {
   std::vector<Eigen::Vector2d> Visible(const Filter& filter, const Camera& camera, int border) const;
   int PlanePoints() const;  // points held by the planes
 
-  // A point or a plane leaves the filter; what it mapped goes to `record`, and a keyframe whose reference
+  // Points or a plane leave the filter; what it mapped goes to `record`, and a keyframe whose reference
   // camera has left the filter goes too.
-  void RemovePoint(int id, Filter* filter, MapRecord* record);
+  void RemovePoints(const std::vector<int>& ids, Filter* filter, MapRecord* record);
   void RemovePlane(int id, Filter* filter, MapRecord* record);
   // Features out of view (or behind the camera) leave; a plane leaves when none of its points is in view.
   void LeaveView(const Camera& camera, int border, Filter* filter, MapRecord* record);
