@@ -8,6 +8,7 @@
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
+#include "pdvo/common/logging.h"
 #include "tool.h"
 
 namespace {
@@ -56,6 +57,7 @@ std::string OneLine(std::string text) {
 
 int main(int argc, char** argv) {
   pdvo::RemoveStagingOnInterrupt();  // first: before any thread starts
+  pdvo::KeepFreedMemory();
   if (argc < 2) {
     PrintUsage(std::cerr);
     return 1;

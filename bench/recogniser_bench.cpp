@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "pdvo/common/logging.h"
 #include "pdvo/infer/recogniser.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
@@ -86,6 +87,7 @@ BENCHMARK(BM_RecogniseRegion100)->Unit(benchmark::kMicrosecond);
 }  // namespace
 
 int main(int argc, char** argv) {
+  pdvo::KeepFreedMemory();  // as pdvo does
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--model=", 8) == 0) g_model_path = argv[i] + 8;
   }

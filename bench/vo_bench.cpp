@@ -43,6 +43,7 @@ double ThreadSeconds() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  pdvo::KeepFreedMemory();  // as pdvo does
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
   pdvo::vo::VoOptions vo_options;

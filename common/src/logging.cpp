@@ -1,7 +1,11 @@
 #include "pdvo/common/logging.h"
 
 #include <unistd.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <exception>
@@ -18,6 +22,16 @@ double ResidentMiB() {
   long pages = 0, resident = 0;
   statm >> pages >> resident;
   return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE)) / (1 << 20);
+}
+
+void KeepFreedMemory(int mib) {
+#if defined(__GLIBC__)
+  const int bytes = mib << 20;
+  mallopt(M_MMAP_THRESHOLD, std::min(bytes, 32 << 20));  // glibc's largest; above it blocks are mapped
+  mallopt(M_TRIM_THRESHOLD, bytes);
+#else
+  (void)mib;
+#endif
 }
 
 namespace {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -166,23 +167,35 @@ std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, doubl
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
                          double normal_scale_deg) {
   const size_t n = points.size();
-  std::vector<std::vector<double>> probabilities(n);
-  std::vector<std::vector<Eigen::Vector3d>> normals(n);
-  for (const DetectedWindow& w : windows) {
+  std::vector<std::vector<int>> holding(n);  // per point, the windows that hold it
+  for (size_t k = 0; k < windows.size(); ++k) {
     for (size_t i = 0; i < n; ++i) {
-      if (!w.box.contains(NearestPixel(points[i]))) continue;
-      probabilities[i].push_back(w.plane_probability);
-      normals[i].push_back(w.normal);
+      if (windows[k].box.contains(NearestPixel(points[i]))) holding[i].push_back(static_cast<int>(k));
     }
   }
   PointPooling out{std::vector<double>(n, 0.5), std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero())};
+  std::map<std::vector<int>, size_t> pooled;  // points held by the same windows (most share a cell) pool alike
+  std::vector<double> probabilities;
+  std::vector<Eigen::Vector3d> normals;
   for (size_t i = 0; i < n; ++i) {
-    if (probabilities[i].empty()) continue;
-    std::vector<double> sorted = probabilities[i];
+    if (holding[i].empty()) continue;
+    const auto [known, fresh] = pooled.emplace(holding[i], i);
+    if (!fresh) {
+      out.planarity[i] = out.planarity[known->second];
+      out.normals[i] = out.normals[known->second];
+      continue;
+    }
+    probabilities.clear();
+    normals.clear();
+    for (const int k : holding[i]) {
+      probabilities.push_back(windows[static_cast<size_t>(k)].plane_probability);
+      normals.push_back(windows[static_cast<size_t>(k)].normal);
+    }
+    std::vector<double> sorted = probabilities;
     std::sort(sorted.begin(), sorted.end());
     const size_t m = sorted.size();
     out.planarity[i] = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
-    out.normals[i] = RobustMeanDirection(normals[i], probabilities[i], normal_scale_deg);
+    out.normals[i] = RobustMeanDirection(normals, probabilities, normal_scale_deg);
   }
   return out;
 }
@@ -238,10 +251,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   for (const cv::Rect& box : boxes) {
     if (features.Points(box) >= model.options.min_points) kept.push_back(box);
   }
-  Eigen::MatrixXd rows(static_cast<Eigen::Index>(kept.size()),
-                       RegionFeatureDims(static_cast<int>(model.topics.cols())));
-  for (size_t k = 0; k < kept.size(); ++k)
-    rows.row(static_cast<Eigen::Index>(k)) = features.Feature(kept[k]).transpose();
+  const Eigen::MatrixXd rows = features.Features(kept);
   const std::vector<RegionPrediction> predictions = recogniser_.PredictRows(rows);
   for (size_t k = 0; k < kept.size(); ++k) {
     const Region region{kept[k], cv::Mat()};

@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core/eigen.hpp>
@@ -286,6 +287,49 @@ Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
   distance.rowwise() += vectors.rowwise().squaredNorm().transpose();
   return (-gamma * distance.cwiseMax(0.0)).array().exp().matrix() * weights -
          Eigen::VectorXd::Constant(rows.rows(), bias);
+}
+
+RvmBank::RvmBank(const std::vector<const RvmFunction*>& functions)
+    : bias_(static_cast<Eigen::Index>(functions.size())), functions_(static_cast<int>(functions.size())) {
+  for (int f = 0; f < functions_; ++f) {
+    const RvmFunction& rvm = *functions[f];
+    bias_[f] = rvm.bias;
+    auto group = std::find_if(groups_.begin(), groups_.end(), [&](const Group& g) { return g.gamma == rvm.gamma; });
+    if (group == groups_.end()) group = groups_.insert(groups_.end(), Group{rvm.gamma, {}, {}, {}});
+    // The group's distinct vectors, in order of first use; exact equality (they are rows of one training set).
+    std::vector<Eigen::VectorXf> distinct;
+    for (Eigen::Index i = 0; i < group->vectors.rows(); ++i) distinct.push_back(group->vectors.row(i));
+    std::vector<std::pair<Eigen::Index, double>> entries;
+    for (Eigen::Index i = 0; i < rvm.vectors.rows(); ++i) {
+      const Eigen::VectorXf v = rvm.vectors.row(i).cast<float>();
+      auto at = std::find(distinct.begin(), distinct.end(), v);
+      if (at == distinct.end()) at = distinct.insert(distinct.end(), v);
+      entries.emplace_back(at - distinct.begin(), rvm.weights[i]);
+    }
+    const Eigen::Index added = static_cast<Eigen::Index>(distinct.size()) - group->vectors.rows();
+    if (added > 0) group->vectors.conservativeResize(static_cast<Eigen::Index>(distinct.size()), rvm.vectors.cols());
+    for (Eigen::Index i = group->vectors.rows() - added; i < group->vectors.rows(); ++i)
+      group->vectors.row(i) = distinct[static_cast<size_t>(i)];
+    group->weights.conservativeResize(group->vectors.rows(), functions_);
+    group->weights.bottomRows(added).setZero();
+    for (const auto& [row, weight] : entries) group->weights(row, f) += weight;
+  }
+  for (Group& g : groups_) g.norms = g.vectors.cast<double>().rowwise().squaredNorm();
+}
+
+Eigen::MatrixXd RvmBank::Evaluate(const Eigen::MatrixXd& rows) const {
+  Eigen::MatrixXd out = -bias_.replicate(rows.rows(), 1);
+  const Eigen::MatrixXf rows_float = rows.cast<float>();
+  const Eigen::VectorXd row_norms = rows_float.cast<double>().rowwise().squaredNorm();
+  Eigen::MatrixXd kernel;
+  for (const Group& g : groups_) {
+    kernel = -2.0 * (rows_float * g.vectors.transpose()).cast<double>();
+    kernel.colwise() += row_norms;
+    kernel.rowwise() += g.norms.transpose();
+    kernel = (-g.gamma * kernel.array().max(0.0)).exp().matrix();
+    out.noalias() += kernel * g.weights;
+  }
+  return out;
 }
 
 bool RecogniserOptions::Check() const {

@@ -146,6 +146,12 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
   });
   PDVO_THROW_CHECK(model_.feature_mean.size() == dims && classifiers_fit, InvalidArgument,
                    "recogniser: the model's features are " << model_.feature_mean.size() << "-D, expected " << dims);
+  if (model_.learner() == LearnerKind::kRvm) {
+    std::vector<const RvmFunction*> functions;
+    for (const Learned& f : model_.classifiers) functions.push_back(&f.rvm);
+    for (const Learned& f : model_.normal) functions.push_back(&f.rvm);
+    rvms_ = RvmBank(functions);
+  }
 }
 
 ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera>& camera) const {
@@ -156,17 +162,7 @@ ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera
 }
 
 RegionPrediction Recogniser::Predict(const Eigen::VectorXd& feature) const {
-  PDVO_THROW_CHECK(feature.size() == model_.feature_mean.size(), InvalidArgument,
-                   "recogniser: a " << feature.size() << "-D feature for a model of " << model_.feature_mean.size());
-  if (model_.learner() != LearnerKind::kRvm) return PredictRows(feature.transpose()).front();
-  const Eigen::VectorXd x = (feature - model_.feature_mean).cwiseQuotient(model_.feature_scale);
-  RegionPrediction p;
-  p.valid = true;
-  for (const Learned& f : model_.classifiers) p.plane_probability += 1.0 / (1.0 + std::exp(-f.rvm(x)));
-  p.plane_probability /= static_cast<double>(model_.classifiers.size());
-  const Eigen::Vector3d n(model_.normal[0].rvm(x), model_.normal[1].rvm(x), model_.normal[2].rvm(x));
-  if (n.norm() > 1e-9) p.normal = n.normalized();
-  return p;
+  return PredictRows(feature.transpose()).front();
 }
 
 std::vector<RegionPrediction> Recogniser::PredictRows(const Eigen::MatrixXd& features) const {
@@ -174,17 +170,24 @@ std::vector<RegionPrediction> Recogniser::PredictRows(const Eigen::MatrixXd& fea
                    "recogniser: " << features.cols() << "-D features for a model of " << model_.feature_mean.size());
   const Eigen::MatrixXd x = (features.rowwise() - model_.feature_mean.transpose()).array().rowwise() /
                             model_.feature_scale.transpose().array();
+  const Eigen::Index classifiers = static_cast<Eigen::Index>(model_.classifiers.size());
   Eigen::VectorXd probability = Eigen::VectorXd::Zero(x.rows());
-  for (const Learned& f : model_.classifiers) probability += f.Evaluate(x);
-  probability /= static_cast<double>(model_.classifiers.size());
-  const Eigen::VectorXd nx = model_.normal[0].Evaluate(x), ny = model_.normal[1].Evaluate(x);
-  const Eigen::VectorXd nz = model_.normal[2].Evaluate(x);
+  Eigen::MatrixXd normal(x.rows(), 3);
+  if (model_.learner() == LearnerKind::kRvm) {  // classifiers' logits, then the normal's components
+    const Eigen::MatrixXd values = rvms_.Evaluate(x);
+    probability = (1.0 + (-values.leftCols(classifiers)).array().exp()).inverse().matrix().rowwise().sum();
+    normal = values.rightCols(3);
+  } else {
+    for (const Learned& f : model_.classifiers) probability += f.Evaluate(x);
+    for (int c = 0; c < 3; ++c) normal.col(c) = model_.normal[c].Evaluate(x);
+  }
+  probability /= static_cast<double>(classifiers);
   std::vector<RegionPrediction> out(static_cast<size_t>(x.rows()));
   for (Eigen::Index k = 0; k < x.rows(); ++k) {
     RegionPrediction& p = out[static_cast<size_t>(k)];
     p.valid = true;
     p.plane_probability = probability[k];
-    const Eigen::Vector3d n(nx[k], ny[k], nz[k]);
+    const Eigen::Vector3d n = normal.row(k).transpose();
     if (n.norm() > 1e-9) p.normal = n.normalized();
   }
   return out;

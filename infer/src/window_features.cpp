@@ -154,20 +154,38 @@ Eigen::VectorXd WindowFeatures::Sum(const cv::Rect& box) const {
 
 int WindowFeatures::Points(const cv::Rect& box) const { return static_cast<int>(std::lround(Sum(box)[0])); }
 
-Eigen::VectorXd WindowFeatures::Feature(const cv::Rect& box) const {
-  const Eigen::VectorXd s = Sum(box);
+Eigen::VectorXd WindowFeatures::Feature(const cv::Rect& box) const { return Features({box}).row(0).transpose(); }
+
+Eigen::MatrixXd WindowFeatures::Features(const std::vector<cv::Rect>& boxes) const {
+  const int words = model_.gradient_words.size() + model_.colour_words.size();
+  std::vector<Eigen::VectorXd> sums;
+  Eigen::MatrixXd histograms(words, static_cast<Eigen::Index>(boxes.size()));  // as CollectRegionWords
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    sums.push_back(Sum(boxes[k]));
+    const double n = sums.back()[0];
+    histograms.col(static_cast<Eigen::Index>(k)) = sums.back().segment(1, words) / (n > 0 ? 2.0 * n : 1.0);
+  }
+  // The topics of all windows at once: the projection's iterations as matrix products.
+  const Eigen::MatrixXd weights = ProjectOntoTopics(model_.topics, gram_, histograms, model_.options.topic_iterations);
+  Eigen::MatrixXd features(static_cast<Eigen::Index>(boxes.size()), RegionFeatureDims(static_cast<int>(gram_.cols())));
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    const Eigen::Index row = static_cast<Eigen::Index>(k);
+    features.row(row) = Complete(boxes[k], sums[k], weights.col(row)).transpose();
+  }
+  return features;
+}
+
+Eigen::VectorXd WindowFeatures::Complete(const cv::Rect& box, const Eigen::VectorXd& s,
+                                         const Eigen::VectorXd& weights) const {
   const int g = model_.gradient_words.size(), c = model_.colour_words.size();
   const int topics = static_cast<int>(model_.topics.cols());
   const int topics_at = 1 + g + c, bins_at = topics_at + kMoments * topics;
   const int families_at = bins_at + kMoments * kOrientationBins;
   const double n = s[0];
-  // As CollectRegionWords: the box in pixel-edge coordinates, the words' histogram.
+  // As CollectRegionWords: the box in pixel-edge coordinates.
   const cv::Rect2d edges(box.x - 0.5, box.y - 0.5, box.width, box.height);
   const Eigen::Vector2d centre(edges.x + edges.width / 2, edges.y + edges.height / 2);
   const Eigen::Vector2d half(edges.width / 2, edges.height / 2);
-  Eigen::VectorXd histogram = s.segment(1, g + c);
-  if (n > 0) histogram /= 2.0 * n;
-  const Eigen::VectorXd weights = ProjectOntoTopics(model_.topics, gram_, histogram, model_.options.topic_iterations);
   Eigen::VectorXd feature(RegionFeatureDims(topics));
   for (int t = 0; t < topics; ++t) {
     MomentsToSpatiogram(weights[t], s.data() + topics_at + kMoments * t, centre, half, feature.data() + kMoments * t);

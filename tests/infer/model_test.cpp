@@ -151,6 +151,33 @@ TEST(Model, RvmFunctionIsTheKernelExpansion) {
   EXPECT_NEAR(f(x), 2 * std::exp(-0.5) - std::exp(-0.5) - 0.25, 1e-15);
 }
 
+// Functions of two kernel widths that share some relevance vectors (one shares all of another's, one repeats a
+// vector of its own, one has none): together, each function's value is what it gives alone.
+TEST(Model, RvmBankEqualsEachFunctionAlone) {
+  std::mt19937 rng(8);
+  std::normal_distribution<double> g(0, 1);
+  std::vector<RvmFunction> f = {RandomRvm(5, 6, rng), RandomRvm(4, 6, rng), RandomRvm(3, 6, rng), RandomRvm(2, 6, rng),
+                                Constant(0.7, 6)};
+  f[1].vectors.topRows(2) = f[0].vectors.middleRows(1, 2);  // shared within a width
+  f[2].gamma = f[3].gamma = 1.3;
+  f[2].vectors = f[0].vectors.topRows(3);     // the same vectors at another width
+  f[3].vectors.row(1) = f[3].vectors.row(0);  // a vector twice in one function
+  const RvmBank bank({&f[0], &f[1], &f[2], &f[3], &f[4]});
+  ASSERT_EQ(bank.functions(), 5);
+  const Eigen::MatrixXd rows = Eigen::MatrixXd::NullaryExpr(7, 6, [&]() { return g(rng); });
+  const Eigen::MatrixXd values = bank.Evaluate(rows);
+  ASSERT_EQ(values.rows(), 7);
+  ASSERT_EQ(values.cols(), 5);
+  for (int i = 0; i < 7; ++i) {
+    for (int k = 0; k < 5; ++k) {
+      // Single precision products (RvmBank): a few 1e-7 relative of the kernel expansion's terms.
+      const double alone = f[k](rows.row(i).transpose());
+      EXPECT_NEAR(values(i, k), alone, 1e-5 * (1 + f[k].weights.cwiseAbs().sum())) << i << " " << k;
+    }
+  }
+  EXPECT_EQ(RvmBank(std::vector<const RvmFunction*>{}).Evaluate(rows).cols(), 0);
+}
+
 TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   const std::string text = RandomModel().ToYaml();
   const auto message_of = [](const std::string& yaml) {

@@ -23,6 +23,19 @@ TEST(Topics, ProjectionRecoversKnownWeights) {
   EXPECT_THROW(ProjectOntoTopics(known.basis, Eigen::VectorXd::Ones(7)), InvalidArgument);
 }
 
+TEST(Topics, ManyRegionsAtOnceEqualOneByOne) {
+  const test::KnownTopics known(60, 5, 20, 7);
+  const Eigen::MatrixXd gram = known.basis.transpose() * known.basis;
+  const Eigen::MatrixXd all = ProjectOntoTopics(known.basis, gram, known.data, 50);
+  ASSERT_EQ(all.rows(), 5);
+  ASSERT_EQ(all.cols(), 20);
+  for (int region = 0; region < 20; ++region) {
+    const Eigen::VectorXd one = ProjectOntoTopics(known.basis, known.data.col(region), 50);
+    EXPECT_LT((all.col(region) - one).cwiseAbs().maxCoeff(), 1e-12 * (1 + one.cwiseAbs().maxCoeff())) << region;
+  }
+  EXPECT_EQ(ProjectOntoTopics(known.basis, gram, Eigen::MatrixXd(60, 0), 50).cols(), 0);
+}
+
 TEST(Topics, MatchesBruteForceNonNegativeLeastSquaresOnAnOverlappingBasis) {
   // Two overlapping topics: the constrained optimum, found by brute force over a fine grid, must agree.
   Eigen::MatrixXd basis(3, 2);

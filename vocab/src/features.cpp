@@ -14,10 +14,13 @@ namespace {
 // SIFT's layout (4x4 cells x 8 orientations), upright and at one scale: the (patch+1)^2 pixels centred on the
 // point vote with their Gaussian-weighted gradient magnitude into the two nearest orientation bins and the
 // (bilinearly) nearest cells; the histogram is normalised, clipped at 0.2, renormalised and scaled by 512.
-void DescribeGradient(const cv::Mat& magnitude, const cv::Mat& angle, cv::Point c, int patch, float* out) {
+// `gaussian`: GaussianWeights(patch).
+void DescribeGradient(const cv::Mat& magnitude, const cv::Mat& angle, cv::Point c, int patch,
+                      const std::vector<float>& gaussian, float* out) {
   std::fill(out, out + kGradientDims, 0.0f);
   const int h = patch / 2;
-  const float cell = patch / 4.0f, sigma = static_cast<float>(h);
+  const float cell = patch / 4.0f;
+  const float* g = gaussian.data();
   for (int dy = -h; dy <= h; ++dy) {
     const float* m = magnitude.ptr<float>(c.y + dy);
     const float* a = angle.ptr<float>(c.y + dy);
@@ -25,7 +28,7 @@ void DescribeGradient(const cv::Mat& magnitude, const cv::Mat& angle, cv::Point 
     const int y0 = static_cast<int>(std::floor(fy));
     const float wy = fy - y0;
     for (int dx = -h; dx <= h; ++dx) {
-      const float w = m[c.x + dx] * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma));
+      const float w = m[c.x + dx] * *g++;
       if (w == 0) continue;
       const float fo = a[c.x + dx] * (8.0f / static_cast<float>(2 * CV_PI));
       const int o0 = static_cast<int>(std::floor(fo));
@@ -55,6 +58,17 @@ void DescribeGradient(const cv::Mat& magnitude, const cv::Mat& angle, cv::Point 
     if (norm <= 0) return;
     for (int k = 0; k < kGradientDims; ++k) out[k] = pass == 0 ? std::min(out[k] / norm, 0.2f) : 512.0f * out[k] / norm;
   }
+}
+
+// The Gaussian weight (sigma: half the patch) of each pixel of a (patch+1)^2 window, row by row.
+std::vector<float> GaussianWeights(int patch) {
+  const int h = patch / 2;
+  const float sigma = static_cast<float>(h);
+  std::vector<float> weights;
+  for (int dy = -h; dy <= h; ++dy) {
+    for (int dx = -h; dx <= h; ++dx) weights.push_back(std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma)));
+  }
+  return weights;
 }
 
 // Mean CIE Lab (each channel / 255) of the 2x2 cells of the patch, from the image's integral.
@@ -141,10 +155,11 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
   cv::Mat lab, lab_sum;
   cv::cvtColor(image, lab, cv::COLOR_BGR2Lab);
   cv::integral(lab, lab_sum, CV_64F);
+  const std::vector<float> gaussian = GaussianWeights(o.patch_size);
   for (size_t i = 0; i < kept.size(); ++i) {
     const cv::Point c(cvRound(kept[i].pt.x), cvRound(kept[i].pt.y));
     f.points.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y));
-    DescribeGradient(magnitude, angle, c, o.patch_size, f.gradient.ptr<float>(static_cast<int>(i)));
+    DescribeGradient(magnitude, angle, c, o.patch_size, gaussian, f.gradient.ptr<float>(static_cast<int>(i)));
     DescribeColour(lab_sum, c, o.patch_size, f.colour.ptr<float>(static_cast<int>(i)));
     const int x0 = c.x - half, y0 = c.y - half, x1 = c.x + half + 1, y1 = c.y + half + 1;  // the window
     const cv::Vec3d t = tensor_sum.at<cv::Vec3d>(y1, x1) - tensor_sum.at<cv::Vec3d>(y0, x1) -

@@ -1,5 +1,6 @@
 #include "pdvo/vocab/vocabulary.h"
 
+#include <Eigen/Core>
 #include <limits>
 #include <random>
 
@@ -27,7 +28,10 @@ int Nearest(const cv::Mat& centres, const float* x, float* distance) {
 Vocabulary::Vocabulary(cv::Mat centres) : centres_(std::move(centres)) {
   PDVO_THROW_CHECK(centres_.type() == CV_32F && centres_.rows >= 1, InvalidArgument,
                    "vocabulary: centres must be a non-empty CV_32F matrix");
-  index_ = std::make_shared<cv::flann::Index>(centres_, cv::flann::KDTreeIndexParams(4), cvflann::FLANN_DIST_L2);
+  if (!centres_.isContinuous()) centres_ = centres_.clone();
+  centre_norms_.resize(centres_.rows);
+  for (int c = 0; c < centres_.rows; ++c)
+    centre_norms_[c] = static_cast<float>(cv::norm(centres_.row(c), cv::NORM_L2SQR));
 }
 
 Vocabulary Vocabulary::Build(const cv::Mat& data, int words, uint64_t seed, int iterations) {
@@ -83,14 +87,32 @@ Vocabulary Vocabulary::Build(const cv::Mat& data, int words, uint64_t seed, int 
   return Vocabulary(centres);
 }
 
-std::vector<int> Vocabulary::Quantise(const cv::Mat& descriptors, int checks) const {
-  PDVO_THROW_CHECK(index_, InvalidArgument, "vocabulary: empty");
+std::vector<int> Vocabulary::Quantise(const cv::Mat& descriptors) const {
+  PDVO_THROW_CHECK(!centres_.empty(), InvalidArgument, "vocabulary: empty");
   if (descriptors.rows == 0) return {};
   PDVO_THROW_CHECK(descriptors.type() == CV_32F && descriptors.cols == dims(), InvalidArgument,
                    "vocabulary: descriptors are " << descriptors.cols << "-D, the words " << dims() << "-D");
-  cv::Mat indices(descriptors.rows, 1, CV_32S), distances(descriptors.rows, 1, CV_32F);
-  index_->knnSearch(descriptors, indices, distances, 1, cv::flann::SearchParams(checks));
-  return std::vector<int>(indices.begin<int>(), indices.end<int>());
+  using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const cv::Mat x_mat = descriptors.isContinuous() ? descriptors : descriptors.clone();
+  const Eigen::Map<const RowMajor> x(x_mat.ptr<float>(), x_mat.rows, x_mat.cols);
+  const Eigen::Map<const RowMajor> centres(centres_.ptr<float>(), centres_.rows, centres_.cols);
+  const Eigen::Map<const Eigen::RowVectorXf> norms(centre_norms_.data(),
+                                                   static_cast<Eigen::Index>(centre_norms_.size()));
+  // |x - c|^2 = |x|^2 - 2 x.c + |c|^2, of which |x|^2 is the same for every word: one matrix product per block.
+  constexpr Eigen::Index kBlock = 256;
+  std::vector<int> words(static_cast<size_t>(x.rows()));
+  Eigen::MatrixXf cost;
+  for (Eigen::Index first = 0; first < x.rows(); first += kBlock) {
+    const Eigen::Index n = std::min(kBlock, x.rows() - first);
+    cost.noalias() = x.middleRows(first, n) * centres.transpose();
+    cost = (-2 * cost).rowwise() + norms;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      Eigen::Index word = 0;
+      cost.row(i).minCoeff(&word);
+      words[static_cast<size_t>(first + i)] = static_cast<int>(word);
+    }
+  }
+  return words;
 }
 
 void Vocabulary::Write(cv::FileStorage& fs, const std::string& name) const {

@@ -23,6 +23,12 @@ LogLevel ParseLogLevel(const std::string& text);
 // The process's resident memory now, in MiB (from /proc/self/statm; 0 where there is none).
 double ResidentMiB();
 
+// Lets the C library's allocator keep freed memory for reuse, up to `mib` MiB: blocks of any size come from the
+// heap (not a fresh mapping each) and the heap is not given back while it is below that. The detector allocates
+// tables of several MiB per image; fresh pages cost a page fault each, which on a virtual machine doubled the
+// detector's time (bench/detector_bench). Call it first thing in main(); a no-op where the allocator is not glibc's.
+void KeepFreedMemory(int mib = 256);
+
 namespace detail {
 // Collects one message and writes it, whole, to stderr when destroyed.
 class LogMessage {

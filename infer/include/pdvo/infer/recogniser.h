@@ -100,11 +100,12 @@ class Recogniser {
   // (FuseNormal in vanishing.h) and without turning the normal to face the camera, which need the image. The
   // plane probability is the mean of the classifiers' logistic probabilities.
   RegionPrediction Predict(const Eigen::VectorXd& feature) const;
-  // Predict for each row of `features` (one region's feature per row), with the RVMs evaluated as matrix products.
+  // Predict for each row of `features` (one region's feature per row), with the RVMs evaluated together (RvmBank).
   std::vector<RegionPrediction> PredictRows(const Eigen::MatrixXd& features) const;
 
  private:
   PlaneModel model_;
+  RvmBank rvms_;  // the classifiers', then the three normal regressors', when the learner is the RVM
 };
 
 }  // namespace pdvo

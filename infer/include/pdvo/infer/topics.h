@@ -9,8 +9,9 @@ namespace pdvo {
 // The non-negative h minimising |histogram - basis * h|^2 (basis: words x topics, non-negative), by
 // multiplicative updates started from max(basis^T histogram, 0) + epsilon. `iterations` bounds the work.
 Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::VectorXd& histogram, int iterations = 200);
-// The same with the basis's Gram matrix basis^T basis given (for many projections onto one basis).
-Eigen::VectorXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::MatrixXd& gram,
-                                  const Eigen::VectorXd& histogram, int iterations);
+// The same for each column of `histograms` (words x regions) at once, with the basis's Gram matrix basis^T basis
+// given: one column of topic weights per region.
+Eigen::MatrixXd ProjectOntoTopics(const Eigen::MatrixXd& basis, const Eigen::MatrixXd& gram,
+                                  const Eigen::MatrixXd& histograms, int iterations);
 
 }  // namespace pdvo

