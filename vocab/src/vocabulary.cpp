@@ -1,6 +1,7 @@
 #include "pdvo/vocab/vocabulary.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <limits>
 #include <random>
 
