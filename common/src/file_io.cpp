@@ -54,15 +54,27 @@ fs::path FollowLinks(fs::path path) {
 }
 
 // Removes the entries of `folder` named `prefix` + PID whose process no longer runs.
-void RemoveStale(const fs::path& folder, const std::string& prefix) {
+// Staging folders `prefix`PID of processes that are gone are removed. `prefix`PID.old is an earlier output that
+// such a process's Commit had moved aside (where the file system cannot exchange two paths): it goes back to
+// `target` if the process died before its own output took that place, and is removed if not.
+void RemoveStale(const fs::path& folder, const std::string& prefix, const fs::path& target) {
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(folder, ec)) {
-    const std::string name = entry.path().filename().string();
+  std::vector<fs::path> entries;
+  for (const auto& entry : fs::directory_iterator(folder, ec)) entries.push_back(entry.path());
+  for (const fs::path& path : entries) {
+    const std::string name = path.filename().string();
     if (name.rfind(prefix, 0) != 0) continue;
-    const std::string digits = name.substr(prefix.size());
+    std::string digits = name.substr(prefix.size());
+    const bool aside = digits.ends_with(".old");
+    if (aside) digits.resize(digits.size() - 4);
     if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
     const pid_t pid = static_cast<pid_t>(std::stol(digits));
-    if (pid != getpid() && kill(pid, 0) == -1 && errno == ESRCH) fs::remove_all(entry.path(), ec);
+    if (pid == getpid() || kill(pid, 0) == 0 || errno != ESRCH) continue;
+    if (aside && !fs::exists(target, ec)) {
+      fs::rename(path, target, ec);
+    } else {
+      fs::remove_all(path, ec);
+    }
   }
 }
 
@@ -211,7 +223,7 @@ StagedOutputDir::StagedOutputDir(const std::string& final_dir) {
   fs::create_directories(parent, ec);
   PDVO_THROW_CHECK(fs::is_directory(parent, ec), IoError, parent.string() << ": cannot create the folder");
   const std::string prefix = std::string(".").append(target.filename().string()).append(".partial-");
-  RemoveStale(parent, prefix);
+  RemoveStale(parent, prefix, target);
   staging_dir_ = (parent / (prefix + std::to_string(getpid()))).string();
   fs::remove_all(staging_dir_, ec);
   Register(staging_dir_);

@@ -172,6 +172,24 @@ TEST(StagedOutputDir, StagingLeftByADeadProcessIsRemovedALiveOnesIsNot) {
   EXPECT_TRUE(fs::exists(other));  // another folder's staging is that folder's business
 }
 
+// A process killed inside Commit, where the file system cannot exchange two paths, may leave the earlier output
+// moved aside (staging + ".old"): it goes back if the new output had not taken its place yet, and is removed if it had.
+TEST(StagedOutputDir, AnEarlierOutputMovedAsideByADeadProcessIsPutBack) {
+  test::TempDir dir;
+  const std::string aside = dir / ".run.partial-999999999.old";  // above any pid_max: no such process
+  WriteFileAtomically(aside + "/" + kOutputMarker, "pdvo output\n");
+  WriteFileAtomically(aside + "/result.txt", "the user's earlier run");
+  {
+    StagedOutputDir out(dir / "run");
+    EXPECT_FALSE(fs::exists(aside));
+    EXPECT_EQ(ReadFile(dir / "run/result.txt"), "the user's earlier run");
+  }
+  WriteFileAtomically(aside + "/result.txt", "older still");  // the new output was already in place
+  StagedOutputDir again(dir / "run");
+  EXPECT_FALSE(fs::exists(aside));
+  EXPECT_EQ(ReadFile(dir / "run/result.txt"), "the user's earlier run");
+}
+
 TEST(Dataset, ImageFolderSortedWithTimes) {
   test::TempDir dir;
   for (int i : {2, 0, 1}) WriteImage(dir / ("img_" + std::to_string(i) + ".png"), Pattern(i * 50));
