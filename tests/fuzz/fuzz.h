@@ -9,16 +9,29 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "pdvo/common/errors.h"
 
 namespace pdvo::fuzz {
 
-// A file of this process's own, rewritten for every input.
+// The input files of this process, removed when it ends (a crash leaves the crashing input behind).
+struct InputFiles {
+  std::set<std::string> paths;
+  ~InputFiles() {
+    for (const std::string& path : paths) std::remove(path.c_str());
+  }
+};
+
+// A file of this process's own in the temporary folder, rewritten for every input.
 inline std::string WriteInput(const uint8_t* data, size_t size, const std::string& extension) {
-  const std::string path = "/tmp/pdvo-fuzz-" + std::to_string(getpid()) + extension;
+  static InputFiles files;
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("pdvo-fuzz-" + std::to_string(getpid()) + extension)).string();
+  files.paths.insert(path);
   std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), size);
   return path;
 }
