@@ -53,7 +53,6 @@ fs::path FollowLinks(fs::path path) {
   return path.lexically_normal();
 }
 
-// Removes the entries of `folder` named `prefix` + PID whose process no longer runs.
 // Staging folders `prefix`PID of processes that are gone are removed. `prefix`PID.old is an earlier output that
 // such a process's Commit had moved aside (where the file system cannot exchange two paths): it goes back to
 // `target` if the process died before its own output took that place, and is removed if not.

@@ -291,30 +291,44 @@ Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
 
 RvmBank::RvmBank(const std::vector<const RvmFunction*>& functions)
     : bias_(static_cast<Eigen::Index>(functions.size())), functions_(static_cast<int>(functions.size())) {
+  // Per kernel width: the distinct vectors in order of first use (exact equality: they are rows of one training
+  // set) and each function's weight on each.
+  struct Entry {
+    size_t vector;
+    int function;
+    double weight;
+  };
+  struct Building {
+    double gamma;
+    std::vector<Eigen::VectorXf> vectors;
+    std::vector<Entry> entries;
+  };
+  std::vector<Building> building;
+  Eigen::Index dims = 0;
   for (int f = 0; f < functions_; ++f) {
     const RvmFunction& rvm = *functions[f];
     bias_[f] = rvm.bias;
-    auto group = std::find_if(groups_.begin(), groups_.end(), [&](const Group& g) { return g.gamma == rvm.gamma; });
-    if (group == groups_.end()) group = groups_.insert(groups_.end(), Group{rvm.gamma, {}, {}, {}});
-    // The group's distinct vectors, in order of first use; exact equality (they are rows of one training set).
-    std::vector<Eigen::VectorXf> distinct;
-    for (Eigen::Index i = 0; i < group->vectors.rows(); ++i) distinct.push_back(group->vectors.row(i));
-    std::vector<std::pair<Eigen::Index, double>> entries;
+    auto group =
+        std::find_if(building.begin(), building.end(), [&](const Building& g) { return g.gamma == rvm.gamma; });
+    if (group == building.end()) group = building.insert(building.end(), Building{rvm.gamma, {}, {}});
     for (Eigen::Index i = 0; i < rvm.vectors.rows(); ++i) {
       const Eigen::VectorXf v = rvm.vectors.row(i).cast<float>();
-      auto at = std::find(distinct.begin(), distinct.end(), v);
-      if (at == distinct.end()) at = distinct.insert(distinct.end(), v);
-      entries.emplace_back(at - distinct.begin(), rvm.weights[i]);
+      const size_t at = std::find(group->vectors.begin(), group->vectors.end(), v) - group->vectors.begin();
+      if (at == group->vectors.size()) group->vectors.push_back(v);
+      group->entries.push_back({at, f, rvm.weights[i]});
+      dims = rvm.vectors.cols();
     }
-    const Eigen::Index added = static_cast<Eigen::Index>(distinct.size()) - group->vectors.rows();
-    if (added > 0) group->vectors.conservativeResize(static_cast<Eigen::Index>(distinct.size()), rvm.vectors.cols());
-    for (Eigen::Index i = group->vectors.rows() - added; i < group->vectors.rows(); ++i)
-      group->vectors.row(i) = distinct[static_cast<size_t>(i)];
-    group->weights.conservativeResize(group->vectors.rows(), functions_);
-    group->weights.bottomRows(added).setZero();
-    for (const auto& [row, weight] : entries) group->weights(row, f) += weight;
   }
-  for (Group& g : groups_) g.norms = g.vectors.cast<double>().rowwise().squaredNorm();
+  for (const Building& b : building) {
+    if (b.vectors.empty()) continue;  // constant functions: their bias is all
+    Group& g = groups_.emplace_back();
+    g.gamma = b.gamma;
+    g.vectors.resize(static_cast<Eigen::Index>(b.vectors.size()), dims);
+    for (size_t i = 0; i < b.vectors.size(); ++i) g.vectors.row(static_cast<Eigen::Index>(i)) = b.vectors[i];
+    g.norms = g.vectors.cast<double>().rowwise().squaredNorm();
+    g.weights = Eigen::MatrixXd::Zero(g.vectors.rows(), functions_);
+    for (const Entry& e : b.entries) g.weights(static_cast<Eigen::Index>(e.vector), e.function) += e.weight;
+  }
 }
 
 Eigen::MatrixXd RvmBank::Evaluate(const Eigen::MatrixXd& rows) const {

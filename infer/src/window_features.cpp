@@ -127,17 +127,23 @@ WindowFeatures::WindowFeatures(const ImageWords& words, const PlaneModel& model,
   }
 }
 
-Eigen::VectorXd WindowFeatures::Sum(const cv::Rect& box) const {
+cv::Rect WindowFeatures::Cells(const cv::Rect& box) const {
   PDVO_THROW_CHECK(box.width > 0 && box.height > 0 && box.x % cell_ == 0 && box.y % cell_ == 0 &&
                        box.width % cell_ == 0 && box.height % cell_ == 0 && box.x >= 0 && box.y >= 0 &&
                        (box.x + box.width) / cell_ <= columns_ && (box.y + box.height) / cell_ <= rows_,
                    InvalidArgument,
                    "window features: the window " << box << " is not on the " << cell_ << " px grid of the image");
-  const int x0 = box.x / cell_, y0 = box.y / cell_, x1 = x0 + box.width / cell_, y1 = y0 + box.height / cell_;
-  auto at = [&](int row, int column) {
-    return Eigen::Map<const Eigen::VectorXd>(&table_[(static_cast<size_t>(row) * (columns_ + 1) + column) * channels_],
-                                             channels_);
-  };
+  return {box.x / cell_, box.y / cell_, box.width / cell_, box.height / cell_};
+}
+
+const double* WindowFeatures::Corner(int row, int column) const {
+  return &table_[(static_cast<size_t>(row) * (columns_ + 1) + column) * channels_];
+}
+
+Eigen::VectorXd WindowFeatures::Sum(const cv::Rect& box) const {
+  const cv::Rect cells = Cells(box);
+  const int x0 = cells.x, y0 = cells.y, x1 = cells.x + cells.width, y1 = cells.y + cells.height;
+  auto at = [&](int row, int column) { return Eigen::Map<const Eigen::VectorXd>(Corner(row, column), channels_); };
   Eigen::VectorXd sum = at(y1, x1) - at(y0, x1) - at(y1, x0) + at(y0, x0);
   const int g = model_.gradient_words.size(), c = model_.colour_words.size();
   const int topic_channels = kMoments * static_cast<int>(model_.topics.cols());
@@ -152,7 +158,11 @@ Eigen::VectorXd WindowFeatures::Sum(const cv::Rect& box) const {
   return sum;
 }
 
-int WindowFeatures::Points(const cv::Rect& box) const { return static_cast<int>(std::lround(Sum(box)[0])); }
+int WindowFeatures::Points(const cv::Rect& box) const {  // the count channel (0) alone
+  const cv::Rect c = Cells(box);
+  const int x1 = c.x + c.width, y1 = c.y + c.height;
+  return static_cast<int>(std::lround(*Corner(y1, x1) - *Corner(c.y, x1) - *Corner(y1, c.x) + *Corner(c.y, c.x)));
+}
 
 Eigen::VectorXd WindowFeatures::Feature(const cv::Rect& box) const { return Features({box}).row(0).transpose(); }
 

@@ -94,6 +94,18 @@ TEST(Model, PlaneProbabilityIsTheClassifiersMeanProbability) {
   const double alone = 1 / (1 + std::exp(-m.classifiers[0].rvm(standardised)));
   EXPECT_NEAR(Recogniser(one).Predict(x).plane_probability, alone, 1e-12);
   EXPECT_GT(std::abs(alone - mean), 1e-3);
+  // At a relevance vector of the first classifier its kernel weighs fully (elsewhere, in 79 dimensions, the
+  // kernels are nearly zero); the products are single precision (RvmBank), hence the tolerance.
+  const Eigen::VectorXd on_vector =
+      m.feature_mean + m.feature_scale.cwiseProduct(m.classifiers[0].rvm.vectors.row(0).transpose());
+  const Eigen::VectorXd at = m.classifiers[0].rvm.vectors.row(0).transpose();
+  double on_mean = 0, bias_only = 0;
+  for (const Learned& f : m.classifiers) {
+    on_mean += 1 / (1 + std::exp(-f.rvm(at))) / 3;
+    bias_only += 1 / (1 + std::exp(f.rvm.bias)) / 3;
+  }
+  ASSERT_GT(std::abs(on_mean - bias_only), 1e-2);
+  EXPECT_NEAR(Recogniser(m).Predict(on_vector).plane_probability, on_mean, 1e-5);
   one.classifiers.clear();
   EXPECT_THROW(Recogniser{one}, InvalidArgument);
 }
@@ -152,14 +164,16 @@ TEST(Model, RvmFunctionIsTheKernelExpansion) {
 }
 
 // Functions of two kernel widths that share some relevance vectors (one shares all of another's, one repeats a
-// vector of its own, one has none): together, each function's value is what it gives alone.
+// vector of its own, one has none): together, each function's value is what it gives alone, and the constant one
+// alone in a width of its own adds no group.
 TEST(Model, RvmBankEqualsEachFunctionAlone) {
   std::mt19937 rng(8);
   std::normal_distribution<double> g(0, 1);
   std::vector<RvmFunction> f = {RandomRvm(5, 6, rng), RandomRvm(4, 6, rng), RandomRvm(3, 6, rng), RandomRvm(2, 6, rng),
                                 Constant(0.7, 6)};
   f[1].vectors.topRows(2) = f[0].vectors.middleRows(1, 2);  // shared within a width
-  f[2].gamma = f[3].gamma = 1.3;
+  f[0].gamma = f[1].gamma = 0.05;  // widths at which the kernels weigh (squared distances are about 12)
+  f[2].gamma = f[3].gamma = 0.2;
   f[2].vectors = f[0].vectors.topRows(3);     // the same vectors at another width
   f[3].vectors.row(1) = f[3].vectors.row(0);  // a vector twice in one function
   const RvmBank bank({&f[0], &f[1], &f[2], &f[3], &f[4]});
@@ -172,10 +186,16 @@ TEST(Model, RvmBankEqualsEachFunctionAlone) {
     for (int k = 0; k < 5; ++k) {
       // Single precision products (RvmBank): a few 1e-7 relative of the kernel expansion's terms.
       const double alone = f[k](rows.row(i).transpose());
-      EXPECT_NEAR(values(i, k), alone, 1e-5 * (1 + f[k].weights.cwiseAbs().sum())) << i << " " << k;
+      const double tolerance = 1e-5 * (1 + f[k].weights.cwiseAbs().sum());
+      EXPECT_NEAR(values(i, k), alone, tolerance) << i << " " << k;
+      if (k < 4) {
+        EXPECT_GT(std::abs(alone + f[k].bias), 100 * tolerance) << "the kernels must weigh: " << i << " " << k;
+      }
     }
   }
   EXPECT_EQ(RvmBank(std::vector<const RvmFunction*>{}).Evaluate(rows).cols(), 0);
+  const RvmFunction constant = Constant(-0.4, 6);  // gamma 1: a width no other function has
+  EXPECT_NEAR(RvmBank({&f[0], &constant}).Evaluate(rows)(3, 1), -0.4, 1e-15);
 }
 
 TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {

@@ -36,6 +36,10 @@ class WindowFeatures {
   Eigen::VectorXd Complete(const cv::Rect& box, const Eigen::VectorXd& sums, const Eigen::VectorXd& weights) const;
   // Sums of the channels over the cells of `box`.
   Eigen::VectorXd Sum(const cv::Rect& box) const;
+  // `box` in cells; throws InvalidArgument for a box off the grid or outside the image.
+  cv::Rect Cells(const cv::Rect& box) const;
+  // The summed-area table's channels at a cell corner.
+  const double* Corner(int row, int column) const;
 
   const ImageWords& words_;
   const PlaneModel& model_;
