@@ -281,12 +281,7 @@ double RvmFunction::operator()(const Eigen::VectorXd& x) const {
 }
 
 Eigen::VectorXd RvmFunction::Evaluate(const Eigen::MatrixXd& rows) const {
-  if (vectors.rows() == 0) return Eigen::VectorXd::Constant(rows.rows(), -bias);
-  Eigen::MatrixXd distance = -2.0 * rows * vectors.transpose();
-  distance.colwise() += rows.rowwise().squaredNorm();
-  distance.rowwise() += vectors.rowwise().squaredNorm().transpose();
-  return (-gamma * distance.cwiseMax(0.0)).array().exp().matrix() * weights -
-         Eigen::VectorXd::Constant(rows.rows(), bias);
+  return RvmBank({this}).Evaluate(rows).col(0);
 }
 
 RvmBank::RvmBank(const std::vector<const RvmFunction*>& functions)
