@@ -81,6 +81,7 @@ nlohmann::json DetectionJson(const vo::DetectionEvent& e, double now) {
                       {"detector_seconds", e.result.seconds},
                       {"detected", e.result.planes.size()},
                       {"seeded", o.seeded},
+                      {"extended", o.extended},
                       {"discarded",
                        {{"small", o.small},
                         {"too_many", o.too_many},
@@ -203,7 +204,7 @@ int RunVo(int argc, char** argv) {
   size_t tracked = 0;
   StatsFile stats(out.path("stats.json"), out.final_path("stats.json"),
                   {{"sequence", sequence_path}, {"mode", OptionName(options.mode)}});
-  int keyframes_detected = 0, planes_detected = 0, planes_seeded = 0;
+  int keyframes_detected = 0, planes_detected = 0, planes_seeded = 0, planes_extended = 0;
   // The paper's Fig. 4; planes are matched to their keyframe's frame by its timestamp.
   vo::MeasurementCurve measured_after(kCurveFrames, options.planes.min_plane_points);
   std::vector<double> times;
@@ -232,6 +233,7 @@ int RunVo(int argc, char** argv) {
       ++keyframes_detected;
       planes_detected += static_cast<int>(e.result.planes.size());
       planes_seeded += e.seeding.seeded;
+      planes_extended += e.seeding.extended;
       keyframes_gone += e.keyframe_gone;
     }
     times.push_back(frame.timestamp);
@@ -319,7 +321,8 @@ int RunVo(int argc, char** argv) {
                                     {"failed", counts.failed},
                                     {"keyframe_gone", keyframes_gone},
                                     {"planes_detected", planes_detected},
-                                    {"planes_seeded", planes_seeded}};
+                                    {"planes_seeded", planes_seeded},
+                                    {"planes_extended", planes_extended}};
     tail["totals"]["detector_wait_seconds"] = waited;
     if (counts.timed_out > 0) {
       PDVO_LOG(Warning) << "vo: " << counts.timed_out << " detections took longer than pdvo.timeout_seconds and "

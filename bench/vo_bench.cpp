@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
   // frame of a restart (bootstrap or lost): the truth is compared in that camera's frame.
   Eigen::Quaterniond gauge = walk.front().world_from_cam.rotation.conjugate();
   std::map<std::pair<int, int>, Eigen::Vector3d> normals;  // (keyframe, plane id): its last normal, keyframe frame
-  int detected = 0, seeded = 0, dropped = 0;
+  int detected = 0, seeded = 0, extended = 0, dropped = 0;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadSeconds();
   std::vector<double> frame_cpu;  // the tracking thread's CPU time per frame
@@ -142,6 +142,7 @@ int main(int argc, char** argv) {
     for (const pdvo::vo::DetectionEvent& e : s.detections) {
       detected += e.seeding.detected;
       seeded += e.seeding.seeded;
+      extended += e.seeding.extended;
       dropped += e.keyframe_gone;
     }
     keyframes += s.keyframe;
@@ -165,6 +166,10 @@ int main(int argc, char** argv) {
       const Eigen::Quaterniond relative = key_estimate.conjugate() * odometry.world_from_cam().rotation;
       const Eigen::Vector3d r = pdvo::LogSO3(relative.conjugate() * relative_truth);
       relative_nees_sum += r.dot(p.ldlt().solve(r));
+    }
+    if (s.bootstrap) {  // the map forgets the planes of the filter the bootstrap replaced, and so does this
+      members.clear();
+      normals.clear();
     }
     if (s.keyframe) {
       key_estimate = odometry.world_from_cam().rotation;
@@ -256,9 +261,9 @@ int main(int argc, char** argv) {
   if (pdvo_mode) {
     const pdvo::vo::Odometry::DetectionCounts counts = odometry.detection_counts();
     std::printf(
-        "  detections       source %s: %d planes detected, %d seeded; %d keyframes dropped (left the "
-        "filter), %d skipped, %d timed out, %d failed\n",
-        source.c_str(), detected, seeded, dropped, counts.skipped, counts.timed_out, counts.failed);
+        "  detections       source %s: %d planes detected, %d seeded, %d extended older planes; %d keyframes "
+        "dropped (left the filter), %d skipped, %d timed out, %d failed\n",
+        source.c_str(), detected, seeded, extended, dropped, counts.skipped, counts.timed_out, counts.failed);
   }
   // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
   std::printf(

@@ -182,6 +182,84 @@ TEST(Filter, PointJoiningAPlaneIsFusedIntoIt) {
   EXPECT_THROW(f.MergePointIntoPlane(point, plane, sigma), InvalidArgument);  // gone
 }
 
+// A plane moved to a later (fixed) reference camera: the same plane, and the same uncertainty of what it says
+// about any point of it; the first reference goes with its last feature; tracked references are refused.
+TEST(Filter, PlaneMovedToAnotherReferenceIsTheSamePlane) {
+  CameraState c;
+  c.velocity = Eigen::Vector3d(0.8, 0.05, 0.2);
+  c.angular_velocity = Eigen::Vector3d(0.05, 0.3, -0.02);
+  Filter f(c, SmallCovariance());
+  const int r0 = f.AddReference(true);
+  const int plane = f.AddPlane(r0, {Eigen::Vector3d(0.3, -0.1, -1.0), 0.2}, 0.2, 0.05);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.5);
+  for (int frame = 0; frame < 6; ++frame) {  // correlate the plane with the camera
+    f.Predict(1.0 / 30, kNoise);
+    std::vector<PointMeasurement> z;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d ray = kCamera.Ray({70.0 + 60 * k, 60.0 + 30 * k});
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(f.PredictPlanePoint(kCamera, plane, ray, &pixel, nullptr));
+      z.push_back({plane, pixel + Eigen::Vector2d(noise(rng), noise(rng)), 0.5, ray});
+    }
+    ASSERT_TRUE(f.Update(kCamera, z).ok());
+  }
+  const int r1 = f.AddReference(true);
+  f.AddPoint(r1, kCamera.Ray({100, 100}), 0.3, 0.1);
+  f.Predict(1.0 / 30, kNoise);
+
+  // What the moved plane says: the inverse depth along a ray of r1, as a function of the state.
+  const Eigen::Vector3d ray = kCamera.Ray({140, 150});
+  const auto moved_rho = [&](Filter g) {
+    EXPECT_TRUE(g.MovePlane(plane, r1));
+    return g.planes().at(plane).plane.InverseDepthAlong(ray);
+  };
+  const int n = f.size();
+  Eigen::RowVectorXd h(n);  // its derivative over the state before the move
+  for (int i = 0; i < n; ++i) {
+    Filter a = f, b = f;
+    a.Apply(1e-7 * Eigen::VectorXd::Unit(n, i));
+    b.Apply(-1e-7 * Eigen::VectorXd::Unit(n, i));
+    h[i] = (moved_rho(a) - moved_rho(b)) / 2e-7;
+  }
+  const Eigen::MatrixXd p = f.covariance();
+  Eigen::Vector2d pixel_before, pixel_after;
+  const Eigen::Vector3d on_plane_r0 =
+      f.references().at(r0).world_from_cam.Inverse() * (f.references().at(r1).world_from_cam * (ray / moved_rho(f)));
+  ASSERT_TRUE(f.PredictPlanePoint(kCamera, plane, on_plane_r0.normalized(), &pixel_before, nullptr));
+
+  ASSERT_TRUE(f.MovePlane(plane, r1));
+  EXPECT_EQ(f.planes().at(plane).reference, r1);
+  EXPECT_FALSE(f.references().count(r0));  // its only feature left it
+  EXPECT_EQ(f.size(), n - 6);
+  ASSERT_TRUE(f.PredictPlanePoint(kCamera, plane, ray, &pixel_after, nullptr));
+  EXPECT_LT((pixel_after - pixel_before).norm(), 1e-9);  // the same point, now on a ray of r1
+  Eigen::RowVectorXd h_after(f.size());                  // the same quantity's derivative over the new state
+  const auto rho = [&](const Filter& g) { return g.planes().at(plane).plane.InverseDepthAlong(ray); };
+  for (int i = 0; i < f.size(); ++i) {
+    Filter a = f, b = f;
+    a.Apply(1e-7 * Eigen::VectorXd::Unit(f.size(), i));
+    b.Apply(-1e-7 * Eigen::VectorXd::Unit(f.size(), i));
+    h_after[i] = (rho(a) - rho(b)) / 2e-7;
+  }
+  const double variance = (h * p * h.transpose())(0, 0);
+  EXPECT_GT(variance, 1e-8);
+  EXPECT_NEAR((h_after * f.covariance() * h_after.transpose())(0, 0), variance, 1e-6 * variance);
+  // Its correlation with the camera, which the updates made.
+  const Eigen::RowVectorXd with_camera = h * p.leftCols<12>(),
+                           with_camera_after = h_after * f.covariance().leftCols<12>();
+  EXPECT_GT(with_camera.cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LT((with_camera_after - with_camera).cwiseAbs().maxCoeff(), 1e-6 * with_camera.cwiseAbs().maxCoeff());
+  EXPECT_GT(MinEigenvalue(f.covariance()), -1e-12);
+
+  // Tracked references: refused, nothing changes.
+  Filter g = BusyFilter();
+  const int busy_plane = g.planes().begin()->first;
+  const Eigen::MatrixXd before = g.covariance();
+  EXPECT_FALSE(g.MovePlane(busy_plane, g.references().rbegin()->first));
+  EXPECT_EQ(g.covariance(), before);
+}
+
 TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   CameraState c;
   c.position = Eigen::Vector3d(1, 2, 3);

@@ -126,6 +126,43 @@ TEST(Idpp, PlanePointsLieOnTheirPlane) {
   EXPECT_NEAR(1 / plane.InverseDepthAlong(-unit), 4.0, 1e-12);
 }
 
+// A plane carried into another camera's frame: the same points satisfy it, its Jacobian is the derivative, and a
+// camera behind the plane gets no plane.
+TEST(Idpp, PlaneInAnotherFrameIsTheSamePlane) {
+  std::mt19937 rng(7);
+  const InversePlane plane = TiltedPlane();
+  for (int trial = 0; trial < 10; ++trial) {
+    const Scene s = RandomScene(rng);
+    const Rigid3d ref_from_current = s.world_from_ref.Inverse() * s.world_from_current;
+    Eigen::Matrix4d j;
+    const InversePlane moved = plane.InFrame(ref_from_current, &j);
+    ASSERT_GT(moved.inverse_distance, 0);
+    EXPECT_NEAR(moved.normal.norm(), plane.normal.norm(), 1e-12);
+    for (int y = 20; y < 240; y += 70) {
+      for (int x = 20; x < 320; x += 90) {
+        const Eigen::Vector3d ray = kCamera.Ray({x, y});
+        const Eigen::Vector3d in_current = ref_from_current.Inverse() * (ray / plane.InverseDepthAlong(ray));
+        EXPECT_NEAR(moved.normal.normalized().dot(in_current) + 1 / moved.inverse_distance, 0, 1e-9);
+        // and a ray of the new camera meets it where the old plane has that point
+        EXPECT_NEAR(1 / moved.InverseDepthAlong(in_current.normalized()), in_current.norm(), 1e-9);
+      }
+    }
+    const double eps = 1e-6;
+    Eigen::Matrix4d numeric;
+    for (int i = 0; i < 4; ++i) {
+      InversePlane a = plane, b = plane;
+      (i < 3 ? a.normal[i] : a.inverse_distance) += eps;
+      (i < 3 ? b.normal[i] : b.inverse_distance) -= eps;
+      const InversePlane ma = a.InFrame(ref_from_current), mb = b.InFrame(ref_from_current);
+      numeric.col(i) << (ma.normal - mb.normal) / (2 * eps), (ma.inverse_distance - mb.inverse_distance) / (2 * eps);
+    }
+    EXPECT_LT((j - numeric).cwiseAbs().maxCoeff(), 1e-6) << j << "\n" << numeric;
+  }
+  // A camera 5 m along the normal's opposite, through the plane (4 m away): behind it.
+  const Rigid3d through(Eigen::Quaterniond::Identity(), -5 * plane.normal.normalized());
+  EXPECT_LE(plane.InFrame(through).inverse_distance, 0);
+}
+
 TEST(Idpp, PlaneJacobianMatchesCentralDifferences) {
   std::mt19937 rng(4);
   const double eps = 1e-6;

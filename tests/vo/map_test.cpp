@@ -8,6 +8,7 @@
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
 #include "pdvo/test/support.h"
+#include "pdvo/vo/tracks.h"
 
 namespace pdvo::vo {
 namespace {
@@ -69,6 +70,32 @@ TEST(Map, ReadsAPathOfOnePoseAndRefusesMalformedFiles) {
   WriteFileAtomically(dir / "text.ply", "hello\n");
   EXPECT_THROW(ReadPly(dir / "text.ply", &path), FormatError);
   EXPECT_THROW(ReadPly(dir / "missing.ply", &path), IoError);
+}
+
+// The record counts a plane once however often it is recorded, with its most points; a discarded filter's
+// planes and what it kept are forgotten, an earlier filter's stay.
+TEST(Map, RecordForgetsADiscardedFilter) {
+  MapRecord record(4);
+  PlaneTrack plane;
+  for (int k = 0; k < 5; ++k) plane.members.push_back({Eigen::Vector2d(10 * k, k * k), Eigen::Vector3d::UnitZ(), {}});
+  record.Record(7, plane);
+  plane.moved_away = 3;
+  record.Record(7, plane);
+  record.KeepPlane(MapPlane{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY()}, {0, 0, 1}});
+  EXPECT_EQ(record.stats().planes, 1);
+  EXPECT_EQ(record.stats().points_per_plane, 8);  // its members and those that moved away
+  record.NewFilter();
+  record.Record(7, plane);  // another filter's plane 7
+  record.KeepPlane(MapPlane{});
+  EXPECT_EQ(record.stats().planes, 2);
+  EXPECT_EQ(record.kept().planes.size(), 2u);
+  record.DiscardFilter();
+  EXPECT_EQ(record.stats().planes, 1);
+  EXPECT_EQ(record.kept().planes.size(), 1u);
+  plane.members.resize(2);
+  plane.moved_away = 1;
+  record.Record(9, plane);  // 3 points: fewer than 4, not a plane
+  EXPECT_EQ(record.stats().planes, 1);
 }
 
 TEST(Map, MeasurementCurveAveragesThePlanesThatReachedTheirPoints) {

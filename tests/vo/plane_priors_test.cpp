@@ -24,6 +24,7 @@ struct Scene {
   int reference = -1;
   FeatureOptions features;
   PdvoOptions options;
+  MapRecord record{4};
 
   Scene() {
     reference = filter.AddReference(true);
@@ -47,7 +48,8 @@ struct Scene {
     return id;
   }
   SeedingOutcome Seed(const std::vector<DetectedPlane>& planes, int frame = 14) {
-    return SeedDetectedPlanes(planes, reference, frame, kCamera, options, features, 1.0, 0.2, &filter, &tracks);
+    return SeedDetectedPlanes(planes, reference, frame, kCamera, options, features, 1.0, 0.2, &filter, &tracks,
+                              &record);
   }
 };
 
@@ -203,6 +205,83 @@ TEST(PlanePriors, GrowthStaysInsideThePolygon) {
     outside_used += c.used && !InsidePolygon(outline, c.pixel);
   }
   EXPECT_EQ(outside_used, 0);
+}
+
+// A wall plane of the first keyframe, with members across it; the camera then moves 1 m right and makes a
+// second keyframe (its own image and corners) whose detection holds most of the members the second keyframe sees.
+struct MovedScene : Scene {
+  int plane = -1, later = -1;
+  MovedScene() {
+    EXPECT_EQ(Seed({Box(20, 20, 300, 220, kFacing)}).seeded, 1);
+    plane = tracks.planes.begin()->first;
+    PlaneTrack& t = tracks.planes.at(plane);
+    for (const Eigen::Vector2d& p : {Eigen::Vector2d(30, 40), Eigen::Vector2d(90, 200), Eigen::Vector2d(200, 60),
+                                     Eigen::Vector2d(250, 180), Eigen::Vector2d(280, 120)}) {
+      t.members.push_back({p, kCamera.Ray(p), {}});
+    }
+    t.candidates.clear();
+    Eigen::VectorXd step = Eigen::VectorXd::Zero(filter.size());
+    step.head<3>() = Eigen::Vector3d(1, 0, 0);
+    filter.Apply(step);
+    later = filter.AddReference(true);
+    Keyframe& k = tracks.keyframes[later];
+    k.frame = 40;
+    k.grey = tracks.keyframes.at(reference).grey.clone();
+    for (const Corner& c : tracks.keyframes.at(reference).corners) k.corners.push_back({c.pixel, false});
+  }
+  SeedingOutcome SeedLater(const std::vector<DetectedPlane>& planes) {
+    return SeedDetectedPlanes(planes, later, 44, kCamera, options, features, 1.0, 0.2, &filter, &tracks, &record);
+  }
+};
+
+TEST(PlanePriors, ADetectionHoldingAnOlderPlaneExtendsIt) {
+  MovedScene s;
+  const size_t members_before = s.tracks.planes.at(s.plane).members.size();
+  const InversePlane before = s.filter.planes().at(s.plane).plane;
+  const double shift = 277 * before.inverse_distance;  // px: the later keyframe sees the wall this far left
+  // The member at x 30 leaves its view.
+  const SeedingOutcome o = s.SeedLater({Box(40, 20, 300, 220, kFacing)});
+  EXPECT_EQ(o.extended, 1);
+  EXPECT_EQ(o.seeded, 0);
+  ASSERT_EQ(s.filter.planes().size(), 1u);  // no new plane
+  const Filter::Plane& moved = s.filter.planes().at(s.plane);
+  EXPECT_EQ(moved.reference, s.later);
+  EXPECT_FALSE(s.filter.references().count(s.reference));  // the first keyframe had nothing else
+  EXPECT_FALSE(s.tracks.keyframes.count(s.reference));
+  // The same wall, as far from the later camera (it moved along it).
+  EXPECT_LT((moved.plane.normal.normalized() - kFacing).norm(), 1e-9);
+  EXPECT_NEAR(moved.plane.inverse_distance, before.inverse_distance, 1e-12);
+  const PlaneTrack& t = s.tracks.planes.at(s.plane);
+  EXPECT_EQ(t.members.size() + t.moved_away, members_before);
+  EXPECT_EQ(t.moved_away, 1);
+  for (const PlanePoint& m : t.members) {
+    EXPECT_LT((kCamera.Ray(m.keyframe_pixel) - m.ray).norm(), 1e-9);  // rays and pixels of the later keyframe
+    EXPECT_GE(m.keyframe_pixel.x(), s.features.border);
+  }
+  EXPECT_TRUE(std::any_of(t.members.begin(), t.members.end(), [&](const PlanePoint& m) {
+    return (m.keyframe_pixel - Eigen::Vector2d(250 - shift, 180)).norm() < 1e-6;
+  }));
+  // It grows in the new polygon, from the later keyframe's corners; the map keeps what it was before it moved.
+  EXPECT_TRUE(t.detected);
+  ASSERT_FALSE(t.region_corners.empty());
+  const std::vector<cv::Point2f> outline = {{40, 20}, {300, 20}, {300, 220}, {40, 220}};
+  for (int i : t.region_corners) {
+    EXPECT_TRUE(InsidePolygon(outline, s.tracks.keyframes.at(s.later).corners.at(i).pixel, s.options.region_margin));
+  }
+  EXPECT_EQ(s.record.kept().planes.size(), 1u);
+  EXPECT_EQ(s.record.stats().points_per_plane, static_cast<double>(members_before));
+}
+
+TEST(PlanePriors, AnOlderPlaneIsNotExtendedByADetectionThatDisagrees) {
+  MovedScene s;
+  const Eigen::Vector3d turned = Eigen::Vector3d(std::sin(0.7), 0, -std::cos(0.7));  // 40 degrees off
+  EXPECT_EQ(s.SeedLater({Box(40, 20, 300, 220, turned)}).extended, 0);
+  EXPECT_EQ(s.filter.planes().at(s.plane).reference, s.reference);
+  // Nor one that holds too few of the points the keyframe sees (2 of 5).
+  MovedScene t;
+  const SeedingOutcome o = t.SeedLater({Box(140, 20, 300, 140, kFacing)});
+  EXPECT_EQ(o.extended, 0);
+  EXPECT_EQ(t.filter.planes().at(t.plane).reference, t.reference);
 }
 
 }  // namespace

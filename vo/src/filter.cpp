@@ -211,6 +211,31 @@ UpdateStatus Filter::MergePointIntoPlane(int point_id, int plane_id, double sigm
   return fused.status;
 }
 
+bool Filter::MovePlane(int plane_id, int reference) {
+  auto it = planes_.find(plane_id);
+  PDVO_THROW_CHECK(it != planes_.end() && references_.count(reference), InvalidArgument,
+                   "filter: no plane " << plane_id << " or reference camera " << reference);
+  Plane& plane = it->second;
+  if (plane.reference == reference) return true;
+  const Reference& from = references_.at(plane.reference);
+  const Reference& to = references_.at(reference);
+  const auto exact = [&](const Reference& r) { return covariance_.middleRows<6>(r.offset).isZero(0); };
+  if (!exact(from) || !exact(to)) return false;
+  Eigen::Matrix4d j;
+  const InversePlane moved = plane.plane.InFrame(from.world_from_cam.Inverse() * to.world_from_cam, &j);
+  if (!(moved.inverse_distance > 0) || !moved.normal.allFinite()) return false;
+  // P <- T P T^T with T the identity but for J on the plane's block.
+  const int o = plane.offset;
+  covariance_.middleRows<4>(o) = (j * covariance_.middleRows<4>(o)).eval();
+  covariance_.middleCols<4>(o) = (covariance_.middleCols<4>(o) * j.transpose()).eval();
+  plane.plane = moved;
+  const int old_reference = plane.reference;
+  plane.reference = reference;
+  ++references_.at(reference).users;
+  Remove({}, {old_reference});
+  return true;
+}
+
 void Filter::Renumber() {
   // Removal keeps the order of what stays: new offsets are the running sum of the block sizes in that order.
   struct Block {

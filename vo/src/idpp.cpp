@@ -17,6 +17,24 @@ Eigen::RowVector4d InversePlane::InverseDepthJacobian(const Eigen::Vector3d& ray
   return j;
 }
 
+InversePlane InversePlane::InFrame(const Rigid3d& old_from_new, Eigen::Matrix4d* jacobian) const {
+  const Eigen::Matrix3d r = old_from_new.rotation.toRotationMatrix();
+  const Eigen::Vector3d& t = old_from_new.translation;
+  const double norm = normal.norm();
+  const Eigen::Vector3d unit = normal / norm;
+  const double distance = unit.dot(t) + 1 / inverse_distance;  // from the new camera's centre
+  InversePlane out{r.transpose() * normal, distance > 0 ? 1 / distance : 0};
+  if (jacobian && distance > 0) {
+    const double rho2 = out.inverse_distance * out.inverse_distance;
+    jacobian->setZero();
+    jacobian->topLeftCorner<3, 3>() = r.transpose();
+    jacobian->block<1, 3>(3, 0) =
+        -rho2 * t.transpose() * (Eigen::Matrix3d::Identity() - unit * unit.transpose()) / norm;
+    (*jacobian)(3, 3) = rho2 / (inverse_distance * inverse_distance);
+  }
+  return out;
+}
+
 bool ProjectInverseDepth(const Camera& camera, const Rigid3d& world_from_current, const Rigid3d& world_from_ref,
                          const Eigen::Vector3d& ray, double rho, Eigen::Vector2d* pixel, ProjectionJacobians* j) {
   const Eigen::Matrix3d rc_t = world_from_current.rotation.toRotationMatrix().transpose();

@@ -59,10 +59,23 @@ double PlaneArea(const PlaneTrack& t) {
   return corners.size() < 3 ? 0.0 : cv::contourArea(corners);
 }
 
+void MapRecord::NewFilter() {
+  ++generation_;
+  kept_points_before_ = kept_.points.size();
+  kept_planes_before_ = kept_.planes.size();
+}
+
+void MapRecord::DiscardFilter() {
+  std::erase_if(records_, [&](const auto& r) { return r.first.first == generation_; });
+  kept_.points.resize(kept_points_before_);
+  kept_.planes.resize(kept_planes_before_);
+}
+
 void MapRecord::Record(int id, const PlaneTrack& t) {
-  if (static_cast<int>(t.members.size()) < min_plane_points_) return;
+  const int points = static_cast<int>(t.members.size()) + t.moved_away;
+  if (points < min_plane_points_) return;
   PlaneRecord& r = records_[{generation_, id}];
-  r.points = std::max(r.points, static_cast<int>(t.members.size()));
+  r.points = std::max(r.points, points);
   r.area = std::max(r.area, PlaneArea(t));
 }
 
@@ -73,7 +86,7 @@ void MapRecord::KeepPoint(const Filter& filter, int id) {
 
 void MapRecord::KeepPlane(const Filter& filter, int id, const PlaneTrack& track) {
   MapPlane plane;
-  if (PlaneInWorld(filter, id, track, min_plane_points_, &plane)) kept_.planes.push_back(plane);
+  if (PlaneInWorld(filter, id, track, min_plane_points_, &plane)) KeepPlane(plane);
 }
 
 void MapRecord::KeepAll(const Filter& filter, const Tracks& tracks) {

@@ -117,6 +117,7 @@ struct Odometry::Impl {
         stats.keyframe = true;
       } else if (std::optional<BootstrapStart> start = bootstrap.Step(grey, timestamp)) {
         for (const auto& [index, pose] : start->revised) trajectory.at(index).world_from_cam = pose;
+        record.DiscardFilter();
         Restart(grey, timestamp, start->camera, o.bootstrap.velocity_sigma * start->camera.velocity.norm(),
                 &start->corners);
         stats.keyframe = stats.bootstrap = true;
@@ -159,7 +160,7 @@ struct Odometry::Impl {
       if (event.keyframe_gone) continue;
       event.seeding = SeedDetectedPlanes(event.result.planes, keyframe->first, frame, camera, o.pdvo, o.features,
                                          o.prior.inverse_depth_sigma / o.prior.inverse_depth, o.prior.inverse_depth,
-                                         filter.get(), &tracks);
+                                         filter.get(), &tracks, &record);
     }
     if (stats->keyframe) {
       detections->Offer(

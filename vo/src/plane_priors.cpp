@@ -6,35 +6,45 @@
 #include <set>
 
 #include "pdvo/common/options.h"
+#include "pdvo/vo/map.h"
 
 namespace pdvo::vo {
 
 bool PdvoOptions::Check() const {
   PDVO_CHECK_OPTION(delay_frames >= 1 && timeout_seconds > 0 && min_plane_distance >= 0 && min_area >= 0);
   PDVO_CHECK_OPTION(normal_sigma > 0 && new_plane_points >= 1 && region_corners >= 0);
-  PDVO_CHECK_OPTION(min_facing > 0 && min_facing < 1);
+  PDVO_CHECK_OPTION(min_facing > 0 && min_facing < 1 && max_extend_angle >= 0 && max_extend_angle <= 180);
   return true;
+}
+
+std::vector<MemberInKeyframe> MembersInKeyframe(const Filter& filter, int plane_id, const PlaneTrack& track,
+                                                int reference, const Camera& camera, int border) {
+  const Filter::Plane& plane = filter.planes().at(plane_id);
+  const Rigid3d keyframe_from_plane_ref = filter.references().at(reference).world_from_cam.Inverse() *
+                                          filter.references().at(plane.reference).world_from_cam;
+  const cv::Size size(camera.width, camera.height);
+  std::vector<MemberInKeyframe> out;
+  for (size_t k = 0; k < track.members.size(); ++k) {
+    const PlanePoint& m = track.members[k];
+    if (plane.reference == reference) {
+      if (Inside(m.keyframe_pixel, size, border)) out.push_back({k, m.keyframe_pixel, m.ray});
+      continue;
+    }
+    const double rho = plane.plane.InverseDepthAlong(m.ray);
+    if (rho <= 0) continue;
+    const Eigen::Vector3d in_keyframe = keyframe_from_plane_ref * Eigen::Vector3d(m.ray / rho);
+    if (in_keyframe.z() <= 0) continue;
+    const Eigen::Vector2d pixel = camera.Project(in_keyframe);
+    if (Inside(pixel, size, border)) out.push_back({k, pixel, in_keyframe.normalized()});
+  }
+  return out;
 }
 
 std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const Tracks& tracks, int reference,
                                                     const Camera& camera) {
-  const Rigid3d keyframe_from_world = filter.references().at(reference).world_from_cam.Inverse();
   std::vector<Eigen::Vector2d> out;
   for (const auto& [id, t] : tracks.planes) {
-    const Filter::Plane& plane = filter.planes().at(id);
-    const Rigid3d& world_from_plane_ref = filter.references().at(plane.reference).world_from_cam;
-    for (const PlanePoint& m : t.members) {
-      if (plane.reference == reference) {
-        out.push_back(m.keyframe_pixel);
-        continue;
-      }
-      const double rho = plane.plane.InverseDepthAlong(m.ray);
-      if (rho <= 0) continue;
-      const Eigen::Vector3d in_keyframe = keyframe_from_world * (world_from_plane_ref * Eigen::Vector3d(m.ray / rho));
-      if (in_keyframe.z() <= 0) continue;
-      const Eigen::Vector2d pixel = camera.Project(in_keyframe);
-      if (Inside(pixel, cv::Size(camera.width, camera.height), 0)) out.push_back(pixel);
-    }
+    for (const MemberInKeyframe& m : MembersInKeyframe(filter, id, t, reference, camera, 0)) out.push_back(m.pixel);
   }
   return out;
 }
@@ -95,12 +105,88 @@ double PlaneInverseDistance(const Filter& filter, const Tracks& tracks, int refe
   return -nearest_rho / n.dot(seed_ray);
 }
 
+// The older plane (another reference camera's) that a detection in keyframe `reference` extends: the one with
+// the most points inside the polygon, if at least max_mapped_points and half of those the keyframe sees, and a
+// normal within max_extend_angle of the detected one. -1 if none.
+int PlaneToExtend(const Filter& filter, const Tracks& tracks, int reference, const std::vector<cv::Point2f>& polygon,
+                  const Eigen::Vector3d& normal, const Camera& camera, const PdvoOptions& o) {
+  int best = -1, best_inside = 0;
+  for (const auto& [id, t] : tracks.planes) {
+    const Filter::Plane& plane = filter.planes().at(id);
+    if (plane.reference == reference) continue;
+    const std::vector<MemberInKeyframe> seen = MembersInKeyframe(filter, id, t, reference, camera, 0);
+    const int inside = static_cast<int>(std::count_if(
+        seen.begin(), seen.end(), [&](const MemberInKeyframe& m) { return InsidePolygon(polygon, m.pixel); }));
+    if (inside < o.max_mapped_points || 2 * inside < static_cast<int>(seen.size()) || inside <= best_inside) continue;
+    const Rigid3d plane_ref_from_keyframe = filter.references().at(plane.reference).world_from_cam.Inverse() *
+                                            filter.references().at(reference).world_from_cam;
+    const Eigen::Vector3d seen_normal = plane.plane.InFrame(plane_ref_from_keyframe).normal.normalized();
+    if (seen_normal.dot(normal) < std::cos(o.max_extend_angle * M_PI / 180)) continue;
+    best = id;
+    best_inside = inside;
+  }
+  return best;
+}
+
+// A detected plane's region in its keyframe: the keyframe's corners inside the polygon (after new ones are looked
+// for), from which it grows, and the keyframe's points inside it, tracked since the keyframe: candidates at once.
+void TakeRegion(const std::vector<cv::Point2f>& polygon, const DetectedPlane& detected, std::vector<int> region,
+                int reference, int frame, const PdvoOptions& o, const Filter& filter, Tracks* tracks,
+                std::set<int>* candidates, PlaneTrack* track) {
+  track->detected = true;
+  track->region_corners = std::move(region);
+  track->outline = detected.polygon;
+  track->new_points = o.new_plane_points;
+  const int age = frame - tracks->keyframes.at(reference).frame;
+  for (const auto& [point, p] : tracks->points) {
+    if (filter.points().at(point).reference == reference && !candidates->count(point) &&
+        InsidePolygon(polygon, p.keyframe_pixel, o.region_margin)) {
+      track->candidates.push_back({point, age});
+      candidates->insert(point);
+    }
+  }
+}
+
+std::vector<int> RegionCorners(const std::vector<cv::Point2f>& polygon, const PdvoOptions& o,
+                               const FeatureOptions& features, Keyframe* keyframe) {
+  AddRegionCorners(polygon, o.region_corners, features, keyframe);
+  std::vector<int> region;
+  for (size_t i = 0; i < keyframe->corners.size(); ++i) {
+    if (InsidePolygon(polygon, keyframe->corners[i].pixel, o.region_margin)) region.push_back(static_cast<int>(i));
+  }
+  return region;
+}
+
+// Plane `id` moves to keyframe `reference` (Filter::MovePlane): the map keeps it as it is (its extent so far),
+// its points become rays and pixels of that keyframe (those it does not see at least `border` inside leave it
+// and count as moved away), its candidates of the old keyframe stay points, and the keyframe goes if its
+// reference camera has. False, and nothing changes, if the plane cannot move.
+bool MovePlaneToKeyframe(int id, int reference, const Camera& camera, int border, Filter* filter, Tracks* tracks,
+                         MapRecord* record, std::set<int>* candidates) {
+  PlaneTrack& track = tracks->planes.at(id);
+  const std::vector<MemberInKeyframe> seen = MembersInKeyframe(*filter, id, track, reference, camera, border);
+  const int old_reference = filter->planes().at(id).reference;
+  MapPlane so_far;
+  const bool mapped = PlaneInWorld(*filter, id, track, record->min_plane_points(), &so_far);
+  if (seen.empty() || !filter->MovePlane(id, reference)) return false;
+  record->Record(id, track);
+  if (mapped) record->KeepPlane(so_far);
+  track.moved_away += static_cast<int>(track.members.size() - seen.size());
+  std::vector<PlanePoint> members;
+  for (const MemberInKeyframe& m : seen) members.push_back({m.pixel, m.ray, track.members[m.member].history});
+  track.members = std::move(members);
+  for (const Candidate& c : track.candidates) candidates->erase(c.point);
+  track.candidates.clear();
+  if (!filter->references().count(old_reference)) tracks->keyframes.erase(old_reference);
+  return true;
+}
+
 }  // namespace
 
 SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int reference, int frame,
                                   const Camera& camera, const PdvoOptions& o, const FeatureOptions& features,
                                   double relative_prior_sigma, double default_inverse_depth, Filter* filter,
-                                  Tracks* tracks) {
+                                  Tracks* tracks, MapRecord* record) {
   Keyframe& keyframe = tracks->keyframes.at(reference);
   std::vector<Eigen::Vector2d> planar = PlanarPixelsInKeyframe(*filter, *tracks, reference, camera);
   std::set<int> candidates;  // points already waiting to join a plane
@@ -135,8 +221,20 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
     const DetectedPlane& detected = *outline.plane;
     const std::vector<cv::Point2f>& polygon = outline.polygon;
     const cv::Moments& m = outline.moments;
-    if (out.seeded >= o.max_planes) {
+    const Eigen::Vector3d n = detected.normal.normalized();
+    if (out.seeded + out.extended >= o.max_planes) {
       ++out.too_many;
+      continue;
+    }
+    // An older plane whose points the polygon holds: it moves to this keyframe and grows in the polygon.
+    const int older = PlaneToExtend(*filter, *tracks, reference, polygon, n, camera, o);
+    if (older >= 0 &&
+        MovePlaneToKeyframe(older, reference, camera, features.border, filter, tracks, record, &candidates)) {
+      PlaneTrack& track = tracks->planes.at(older);
+      TakeRegion(polygon, detected, RegionCorners(polygon, o, features, &keyframe), reference, frame, o, *filter,
+                 tracks, &candidates, &track);
+      for (const PlanePoint& member : track.members) planar.push_back(member.keyframe_pixel);
+      ++out.extended;
       continue;
     }
     const Eigen::Vector2d centroid(m.m10 / m.m00, m.m01 / m.m00);
@@ -153,20 +251,16 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       ++out.mapped;
       continue;
     }
-    AddRegionCorners(polygon, o.region_corners, features, &keyframe);
-    std::vector<int> region;  // the keyframe's corners inside the polygon
+    std::vector<int> region = RegionCorners(polygon, o, features, &keyframe);
     Corner* seed = nullptr;
-    for (size_t i = 0; i < keyframe.corners.size(); ++i) {
+    for (int i : region) {
       Corner& c = keyframe.corners[i];
-      if (!InsidePolygon(polygon, c.pixel, o.region_margin)) continue;
-      region.push_back(static_cast<int>(i));
       if (!c.used && (!seed || (c.pixel - centroid).squaredNorm() < (seed->pixel - centroid).squaredNorm())) seed = &c;
     }
     if (!seed) {
       ++out.no_corner;
       continue;
     }
-    const Eigen::Vector3d n = detected.normal.normalized();
     const Eigen::Vector3d ray = camera.Ray(seed->pixel);
     if (n.dot(ray) > -o.min_facing) {
       ++out.grazing;
@@ -178,18 +272,7 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
     const int id = filter->AddPlane(reference, {n, rho_p}, o.normal_sigma, relative_prior_sigma * rho_p);
     PlaneTrack& track = tracks->planes[id];
     track.members.push_back({seed->pixel, ray, {}});
-    track.detected = true;
-    track.region_corners = std::move(region);
-    track.outline = detected.polygon;
-    track.new_points = o.new_plane_points;
-    // The keyframe's points inside the polygon have been tracked since the keyframe: candidates at once.
-    for (const auto& [point, p] : tracks->points) {
-      if (filter->points().at(point).reference == reference && !candidates.count(point) &&
-          InsidePolygon(polygon, p.keyframe_pixel, o.region_margin)) {
-        track.candidates.push_back({point, frame - keyframe.frame});
-        candidates.insert(point);
-      }
-    }
+    TakeRegion(polygon, detected, std::move(region), reference, frame, o, *filter, tracks, &candidates, &track);
     planar.push_back(seed->pixel);
     ++out.seeded;
   }

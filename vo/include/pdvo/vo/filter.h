@@ -122,6 +122,12 @@ class Filter {
   // kOk), nothing changes and the point stays.
   UpdateStatus MergePointIntoPlane(int point, int plane, double sigma);
 
+  // The plane moves to reference camera `reference`: the same plane in that camera's frame (InversePlane::InFrame),
+  // its covariance rows and columns carried by the transform's Jacobian. Its old reference camera goes if it has
+  // no other feature. Both cameras' poses must be exact (fixed references, AddReference); false, and nothing
+  // changes, if they are not, or if the new camera does not see the plane's front.
+  bool MovePlane(int plane, int reference);
+
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.
   bool PredictPoint(const Camera& camera, int point, Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const;

@@ -29,6 +29,11 @@ struct InversePlane {
   double InverseDepthAlong(const Eigen::Vector3d& ray) const;
   // Its derivative with respect to (n, rho_p): rho = -rho_p (n^ . m) with d n^ / d n = (I - n^ n^T) / |n|.
   Eigen::RowVector4d InverseDepthJacobian(const Eigen::Vector3d& ray) const;
+  // The same plane in the frame of another camera, given old_from_new (points x_old = old_from_new * x_new):
+  // n' = R^T n (its length kept) and rho_p' = 1 / (n^ . t + 1 / rho_p). `jacobian` (4x4): d(n', rho_p') /
+  // d(n, rho_p) with the cameras exact. The result's inverse_distance is <= 0 if the new camera is not on the
+  // side the normal points to (it would not see the plane's front).
+  InversePlane InFrame(const Rigid3d& old_from_new, Eigen::Matrix4d* jacobian = nullptr) const;
 };
 
 // Jacobians of a projected pixel.

@@ -80,12 +80,17 @@ double PlaneArea(const PlaneTrack& track);
 class MapRecord {
  public:
   explicit MapRecord(int min_plane_points) : min_plane_points_(min_plane_points) {}
-  void NewFilter() { ++generation_; }
-  // A plane's size now: its record keeps the most points and the largest area (if it has min_plane_points).
+  void NewFilter();
+  // Forgets what the current filter mapped (its planes' records and what it kept): the two-view bootstrap
+  // replaces it with a filter of another scale, and what it mapped before is guessed depth in that other frame.
+  void DiscardFilter();
+  // A plane's size now: its record keeps the most points (members and those that moved away) and the largest
+  // area (if it has min_plane_points).
   void Record(int plane_id, const PlaneTrack& track);
   // Keeps what a feature that leaves the filter has mapped.
   void KeepPoint(const Filter& filter, int id);
   void KeepPlane(const Filter& filter, int id, const PlaneTrack& track);
+  void KeepPlane(const MapPlane& plane) { kept_.planes.push_back(plane); }
   // Keeps everything in the filter now (before a restart).
   void KeepAll(const Filter& filter, const Tracks& tracks);
 
@@ -98,6 +103,7 @@ class MapRecord {
   int generation_ = 0;
   std::map<std::pair<int, int>, PlaneRecord> records_;  // by (generation, plane id)
   Map kept_;
+  size_t kept_points_before_ = 0, kept_planes_before_ = 0;  // kept_'s sizes when the filter started
 };
 
 // The features in the filter now, as map entries.

@@ -7,8 +7,12 @@
 // median of what their inverse depths say, given the normal; the nearest point's if fewer than three; the
 // odometry's prior if none). Its candidates are the keyframe's points inside the polygon (tracked since the
 // keyframe) and new corners found inside it, at least region_margin from the outline; it takes up to
-// new_plane_points of them a frame, each through the 3D consistency test (plane_growing.h). Pixels are the
-// keyframe's working image.
+// new_plane_points of them a frame, each through the 3D consistency test (plane_growing.h).
+// A detection whose polygon holds most of the points of one older plane (anchored at an earlier keyframe) that
+// the keyframe sees, with a normal that agrees, extends that plane instead: the plane moves to the keyframe
+// (Filter::MovePlane; its points become the keyframe's rays and pixels) and grows in the polygon as a new one
+// would. A surface that stays in view is then one plane however many keyframes see it, as one map plane should
+// be, not a new plane per keyframe. Pixels are the keyframe's working image.
 #pragma once
 
 #include <vector>
@@ -31,8 +35,11 @@ struct PdvoOptions {
   double min_area = 1500;          // px^2 in the keyframe: smaller detections are not used
   double min_score = 0;            // detections of a lower score are not used
   int max_planes = 10;             // planes seeded per keyframe, at most: the largest detections first
-  // A detection whose polygon holds this many planar points visible in the keyframe is mapped already.
+  // A detection whose polygon holds this many planar points visible in the keyframe is mapped already: if most
+  // of one older plane's points the keyframe sees are inside, with a normal within max_extend_angle (degrees)
+  // of the detected one, that plane is extended (moved to the keyframe, to grow in the polygon); else dropped.
   int max_mapped_points = 3;
+  double max_extend_angle = 10;
   // The prior standard deviation of each component of a detected (unit) normal (about 9 degrees; the shipped
   // model's matched planes are 2-3 degrees off on held-out streets, more on real images: docs/detector.md).
   double normal_sigma = 0.15;
@@ -55,6 +62,7 @@ struct PdvoOptions {
     visit("min_score", self.min_score);
     visit("max_planes", self.max_planes);
     visit("max_mapped_points", self.max_mapped_points);
+    visit("max_extend_angle", self.max_extend_angle);
     visit("normal_sigma", self.normal_sigma);
     visit("new_plane_points", self.new_plane_points);
     visit("region_corners", self.region_corners);
@@ -69,6 +77,7 @@ struct PdvoOptions {
 struct SeedingOutcome {
   int detected = 0;
   int seeded = 0;
+  int extended = 0;    // an older plane's points are inside the polygon: it moved here and grows in the polygon
   int small = 0;       // polygon smaller than min_area, or score below min_score
   int too_many = 0;    // max_planes were seeded already (from larger detections)
   int near_plane = 0;  // centroid within min_plane_distance of a planar point visible in the keyframe
@@ -78,6 +87,15 @@ struct SeedingOutcome {
   int invalid = 0;     // fewer than 3 polygon points, a degenerate polygon, or a normal that is not finite
 };
 
+// The points of plane `id` (track `track`) that keyframe `reference` sees at least `border` px inside: index in
+// track.members, pixel and ray (unit) of the keyframe.
+struct MemberInKeyframe {
+  size_t member = 0;
+  Eigen::Vector2d pixel;
+  Eigen::Vector3d ray;
+};
+std::vector<MemberInKeyframe> MembersInKeyframe(const Filter& filter, int id, const PlaneTrack& track, int reference,
+                                                const Camera& camera, int border);
 // The planar points of `tracks` as keyframe `reference` of `filter` sees them (pixels; inside the image).
 std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const Tracks& tracks, int reference,
                                                     const Camera& camera);
@@ -85,10 +103,10 @@ std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const 
 // Seeds the planes detected in keyframe `reference` (which must be in `filter` and `tracks`) at frame `frame`,
 // as the header says. `relative_prior_sigma`: an inverse distance's prior standard deviation as a share of it;
 // `default_inverse_depth`: the prior where the keyframe has no point. Adds planes to `filter` and `tracks`, and
-// corners to the keyframe.
+// corners to the keyframe; a plane that moves leaves what it mapped so far in `record`.
 SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int reference, int frame,
                                   const Camera& camera, const PdvoOptions& options, const FeatureOptions& features,
                                   double relative_prior_sigma, double default_inverse_depth, Filter* filter,
-                                  Tracks* tracks);
+                                  Tracks* tracks, MapRecord* record);
 
 }  // namespace pdvo::vo

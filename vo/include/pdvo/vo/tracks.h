@@ -109,6 +109,9 @@ struct PlaneTrack {
   std::vector<int> region_corners;
   std::vector<Eigen::Vector2d> outline;  // a detected plane's polygon, keyframe pixels
   int new_points = 0;
+  // Points that left it when it moved to a later keyframe that does not see them (plane_priors.h): mapped, they
+  // count among its points as the members out of view of a plane that stays do.
+  int moved_away = 0;
 };
 
 // The features of one filter, by the filter's ids, and the keyframes they come from. Every point and plane of
