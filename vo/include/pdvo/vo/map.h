@@ -90,6 +90,7 @@ class MapRecord {
   // Keeps what a feature that leaves the filter has mapped.
   void KeepPoint(const Filter& filter, int id);
   void KeepPlane(const Filter& filter, int id, const PlaneTrack& track);
+  // Keeps a plane's polygon as it is now (a plane that moves to a later keyframe keeps its extent so far).
   void KeepPlane(const MapPlane& plane) { kept_.planes.push_back(plane); }
   // Keeps everything in the filter now (before a restart).
   void KeepAll(const Filter& filter, const Tracks& tracks);
