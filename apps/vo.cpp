@@ -237,6 +237,8 @@ int RunVo(int argc, char** argv) {
       keyframes_gone += e.keyframe_gone;
     }
     times.push_back(frame.timestamp);
+    // The planes of a filter that the bootstrap replaced are not in the map, nor in the curve.
+    if (s.bootstrap) measured_after = vo::MeasurementCurve(kCurveFrames, options.planes.min_plane_points);
     for (const vo::Observation& o : odometry.observations()) {
       if (o.plane < 0) continue;
       const int keyframe =

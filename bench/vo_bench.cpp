@@ -170,6 +170,7 @@ int main(int argc, char** argv) {
     if (s.bootstrap) {  // the map forgets the planes of the filter the bootstrap replaced, and so does this
       members.clear();
       normals.clear();
+      measured_after = pdvo::vo::MeasurementCurve(kCurveFrames, vo_options.planes.min_plane_points);
     }
     if (s.keyframe) {
       key_estimate = odometry.world_from_cam().rotation;
