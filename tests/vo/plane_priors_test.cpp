@@ -277,11 +277,19 @@ TEST(PlanePriors, AnOlderPlaneIsNotExtendedByADetectionThatDisagrees) {
   const Eigen::Vector3d turned = Eigen::Vector3d(std::sin(0.7), 0, -std::cos(0.7));  // 40 degrees off
   EXPECT_EQ(s.SeedLater({Box(40, 20, 300, 220, turned)}).extended, 0);
   EXPECT_EQ(s.filter.planes().at(s.plane).reference, s.reference);
-  // Nor one that holds too few of the points the keyframe sees (2 of 5).
+  // Nor one that holds too few of the points the later keyframe sees: 2 of 5 (fewer than max_mapped_points).
   MovedScene t;
-  const SeedingOutcome o = t.SeedLater({Box(140, 20, 300, 140, kFacing)});
-  EXPECT_EQ(o.extended, 0);
+  EXPECT_EQ(t.SeedLater({Box(140, 20, 300, 140, kFacing)}).extended, 0);
   EXPECT_EQ(t.filter.planes().at(t.plane).reference, t.reference);
+  // A fourth member inside that outline: 3 of 6 (half) extends the plane; one more outside, 3 of 7, does not.
+  for (const bool outside : {false, true}) {
+    MovedScene u;
+    std::vector<PlanePoint>& members = u.tracks.planes.at(u.plane).members;
+    const Eigen::Vector2d in(260, 50), out(120, 210);  // the later keyframe sees them 55 px further left
+    members.push_back({in, kCamera.Ray(in), {}});
+    if (outside) members.push_back({out, kCamera.Ray(out), {}});
+    EXPECT_EQ(u.SeedLater({Box(140, 20, 300, 140, kFacing)}).extended, outside ? 0 : 1) << outside;
+  }
 }
 
 }  // namespace

@@ -17,6 +17,15 @@ bool PdvoOptions::Check() const {
   return true;
 }
 
+namespace {
+
+// The points of plane `id` (track `track`) that keyframe `reference` sees at least `border` px inside: index in
+// track.members, pixel and ray (unit) of the keyframe.
+struct MemberInKeyframe {
+  size_t member = 0;
+  Eigen::Vector2d pixel;
+  Eigen::Vector3d ray;
+};
 std::vector<MemberInKeyframe> MembersInKeyframe(const Filter& filter, int plane_id, const PlaneTrack& track,
                                                 int reference, const Camera& camera, int border) {
   const Filter::Plane& plane = filter.planes().at(plane_id);
@@ -39,6 +48,8 @@ std::vector<MemberInKeyframe> MembersInKeyframe(const Filter& filter, int plane_
   }
   return out;
 }
+
+}  // namespace
 
 std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const Tracks& tracks, int reference,
                                                     const Camera& camera) {
@@ -165,10 +176,11 @@ bool MovePlaneToKeyframe(int id, int reference, const Camera& camera, int border
                          MapRecord* record, std::set<int>* candidates) {
   PlaneTrack& track = tracks->planes.at(id);
   const std::vector<MemberInKeyframe> seen = MembersInKeyframe(*filter, id, track, reference, camera, border);
+  if (seen.empty()) return false;
   const int old_reference = filter->planes().at(id).reference;
   MapPlane so_far;
   const bool mapped = PlaneInWorld(*filter, id, track, record->min_plane_points(), &so_far);
-  if (seen.empty() || !filter->MovePlane(id, reference)) return false;
+  if (!filter->MovePlane(id, reference)) return false;
   record->Record(id, track);
   if (mapped) record->KeepPlane(so_far);
   track.moved_away += static_cast<int>(track.members.size() - seen.size());
@@ -233,7 +245,6 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       PlaneTrack& track = tracks->planes.at(older);
       TakeRegion(polygon, detected, RegionCorners(polygon, o, features, &keyframe), reference, frame, o, *filter,
                  tracks, &candidates, &track);
-      for (const PlanePoint& member : track.members) planar.push_back(member.keyframe_pixel);
       ++out.extended;
       continue;
     }

@@ -87,15 +87,6 @@ struct SeedingOutcome {
   int invalid = 0;     // fewer than 3 polygon points, a degenerate polygon, or a normal that is not finite
 };
 
-// The points of plane `id` (track `track`) that keyframe `reference` sees at least `border` px inside: index in
-// track.members, pixel and ray (unit) of the keyframe.
-struct MemberInKeyframe {
-  size_t member = 0;
-  Eigen::Vector2d pixel;
-  Eigen::Vector3d ray;
-};
-std::vector<MemberInKeyframe> MembersInKeyframe(const Filter& filter, int id, const PlaneTrack& track, int reference,
-                                                const Camera& camera, int border);
 // The planar points of `tracks` as keyframe `reference` of `filter` sees them (pixels; inside the image).
 std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const Tracks& tracks, int reference,
                                                     const Camera& camera);
