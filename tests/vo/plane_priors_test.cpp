@@ -1,7 +1,8 @@
 // Detected planes as priors, on a wall of known depth: a detection is seeded at the corner nearest its centroid
 // with the detected normal as its prior and the inverse distance its keyframe's points say; the paper's 30 px
 // rule, the small, mapped, grazing and invalid cases are refused and counted; the plane grows only from corners
-// inside its polygon, at most new_plane_points a frame; a detection reaches an older keyframe than the newest.
+// inside its polygon, at most new_plane_points a frame; a detection reaches an older keyframe than the newest;
+// a later detection extends an older plane in view, or carries on one that waits out of view.
 #include "pdvo/vo/plane_priors.h"
 
 #include <gtest/gtest.h>
@@ -290,6 +291,76 @@ TEST(PlanePriors, AnOlderPlaneIsNotExtendedByADetectionThatDisagrees) {
     if (outside) members.push_back({out, kCamera.Ray(out), {}});
     EXPECT_EQ(u.SeedLater({Box(140, 20, 300, 140, kFacing)}).extended, outside ? 0 : 1) << outside;
   }
+}
+
+// The wall plane of the first keyframe, with members across it; the camera then moves 6 m along the wall, where
+// none of them is in view, and makes a later keyframe there.
+struct PassedScene : Scene {
+  int plane = -1, later = -1;
+  PassedScene() {
+    EXPECT_EQ(Seed({Box(20, 20, 300, 220, kFacing)}).seeded, 1);
+    plane = tracks.planes.begin()->first;
+    PlaneTrack& t = tracks.planes.at(plane);
+    for (const Eigen::Vector2d& p :
+         {Eigen::Vector2d(30, 40), Eigen::Vector2d(90, 200), Eigen::Vector2d(200, 60), Eigen::Vector2d(280, 120)}) {
+      t.members.push_back({p, kCamera.Ray(p), {}});
+    }
+    t.candidates.clear();
+    Eigen::VectorXd step = Eigen::VectorXd::Zero(filter.size());
+    step.head<3>() = Eigen::Vector3d(6, 0, 0);
+    filter.Apply(step);
+    tracks.LeaveView(kCamera, features.border, &filter, &record);
+    later = filter.AddReference(true);
+    Keyframe& k = tracks.keyframes[later];
+    k.frame = 70;
+    k.grey = tracks.keyframes.at(reference).grey.clone();
+    for (const Corner& c : tracks.keyframes.at(reference).corners) k.corners.push_back({c.pixel, false});
+  }
+  SeedingOutcome SeedLater(const std::vector<DetectedPlane>& planes) {
+    return SeedDetectedPlanes(planes, later, 74, kCamera, options, features, 1.0, 0.2, &filter, &tracks, &record);
+  }
+};
+
+TEST(PlanePriors, APlaneOutOfViewIsCarriedOnByTheNextDetectionOfItsOrientation) {
+  PassedScene s;
+  ASSERT_TRUE(s.filter.planes().count(s.plane));
+  PlaneTrack& waiting = s.tracks.planes.at(s.plane);
+  ASSERT_TRUE(waiting.out_of_view);
+  const int age = waiting.age;
+  const PlaneOptions planes;
+  PlaneGrower(kCamera, planes, s.features, 1.0).Grow(&s.filter, &s.tracks, &s.record);
+  EXPECT_EQ(s.tracks.planes.at(s.plane).age, age);  // a waiting plane does not grow (nor age)
+  const InversePlane before = s.filter.planes().at(s.plane).plane;
+  const SeedingOutcome o = s.SeedLater({Box(60, 40, 260, 200, kFacing)});
+  EXPECT_EQ(o.extended, 1);
+  EXPECT_EQ(o.seeded, 0);
+  ASSERT_EQ(s.filter.planes().size(), 1u);
+  const Filter::Plane& moved = s.filter.planes().at(s.plane);
+  EXPECT_EQ(moved.reference, s.later);
+  EXPECT_NEAR(moved.plane.inverse_distance, before.inverse_distance, 1e-12);  // the same wall, as far
+  const PlaneTrack& t = s.tracks.planes.at(s.plane);
+  EXPECT_FALSE(t.out_of_view);
+  EXPECT_EQ(t.age, 0);
+  ASSERT_EQ(t.members.size(), 1u);  // the seed of the later keyframe; the five earlier ones moved away
+  EXPECT_EQ(t.moved_away, 5);
+  const std::vector<cv::Point2f> outline = {{60, 40}, {260, 40}, {260, 200}, {60, 200}};
+  EXPECT_TRUE(InsidePolygon(outline, t.members[0].keyframe_pixel, s.options.region_margin));
+  EXPECT_FALSE(t.region_corners.empty());
+  EXPECT_EQ(s.record.kept().planes.size(), 1u);  // what it mapped before, kept
+  EXPECT_EQ(s.record.stats().planes, 1);         // one plane, not two
+}
+
+TEST(PlanePriors, APlaneOutOfViewIsNotCarriedOnByAnotherOrientation) {
+  PassedScene s;
+  const Eigen::Vector3d turned = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));  // 20 degrees off
+  const SeedingOutcome o = s.SeedLater({Box(60, 40, 260, 200, turned)});
+  EXPECT_EQ(o.extended, 0);
+  EXPECT_EQ(o.seeded, 1);
+  EXPECT_EQ(s.filter.planes().at(s.plane).reference, s.reference);
+  EXPECT_TRUE(s.tracks.planes.at(s.plane).out_of_view);
+  s.tracks.RemoveOutOfView(&s.filter, &s.record);  // as the odometry does after each detection
+  EXPECT_FALSE(s.filter.planes().count(s.plane));
+  EXPECT_EQ(s.filter.planes().size(), 1u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Feature bookkeeping and frame preparation: features out of view leave the filter (what they mapped is kept,
-// and a keyframe goes with its last feature's reference camera); features with a bad history leave; frames are
-// undistorted, resized and converted to grey for the working camera, and frames of another size are refused.
+// and a keyframe goes with its last feature's reference camera), detected planes wait out of view; features with
+// a bad history leave; frames are undistorted, resized and converted to grey for the working camera, and frames
+// of another size are refused.
 #include "pdvo/vo/tracks.h"
 
 #include <gtest/gtest.h>
@@ -44,6 +45,47 @@ TEST(Tracks, FeaturesOutOfViewLeave) {
   tracks.LeaveRejected(options, &filter, &record);
   EXPECT_TRUE(filter.points().empty());
   EXPECT_TRUE(tracks.keyframes.empty());
+}
+
+TEST(Tracks, DetectedPlanesOutOfViewWaitBlindOnesLeave) {
+  Filter filter(CameraState(), Matrix12d::Identity() * 1e-8);
+  Tracks tracks;
+  MapRecord record(4);
+  const int reference = filter.AddReference(true);
+  tracks.keyframes[reference] = {};
+  // Planes 5 m ahead whose members the camera sees only at the left border: out of view.
+  auto plane = [&](bool detected, int members) {
+    const int id = filter.AddPlane(reference, {Eigen::Vector3d(0, 0, -1), 0.2}, 0.1, 0.01);
+    PlaneTrack& t = tracks.planes[id];
+    t.detected = detected;
+    for (int k = 0; k < members; ++k) {
+      const Eigen::Vector2d pixel(4, 20 + 20 * k);
+      t.members.push_back({pixel, kCamera.Ray(pixel), {}});
+    }
+    return id;
+  };
+  const int blind = plane(false, 5), small = plane(true, 3);
+  std::vector<int> waiting;
+  for (int k = 0; k < kMaxOutOfViewPlanes + 1; ++k) waiting.push_back(plane(true, 4));
+  tracks.LeaveView(kCamera, 10, &filter, &record);
+  EXPECT_FALSE(filter.planes().count(blind));       // a blind seed leaves, as before
+  EXPECT_FALSE(filter.planes().count(small));       // fewer than min_plane_points: no plane to carry on
+  EXPECT_FALSE(filter.planes().count(waiting[0]));  // the oldest beyond kMaxOutOfViewPlanes
+  for (size_t k = 1; k < waiting.size(); ++k) {
+    ASSERT_TRUE(filter.planes().count(waiting[k]));
+    EXPECT_TRUE(tracks.planes.at(waiting[k]).out_of_view);
+  }
+  EXPECT_EQ(record.kept().planes.size(), 2u);  // the blind plane and the oldest waiting one, mapped
+  EXPECT_EQ(record.stats().planes, 1 + static_cast<int>(waiting.size()));  // all with 4 points, waiting or not
+  // A waiting plane whose points come back into view measures again.
+  PlanePoint& back = tracks.planes.at(waiting[1]).members[0];
+  back.keyframe_pixel = {160, 120};
+  back.ray = kCamera.Ray(back.keyframe_pixel);
+  tracks.LeaveView(kCamera, 10, &filter, &record);
+  EXPECT_FALSE(tracks.planes.at(waiting[1]).out_of_view);
+  tracks.RemoveOutOfView(&filter, &record);
+  EXPECT_EQ(filter.planes().size(), 1u);
+  EXPECT_EQ(record.kept().planes.size(), 5u);  // and the three still waiting
 }
 
 TEST(Tracks, HistoriesSayWhenAFeatureLeaves) {

@@ -148,19 +148,19 @@ struct Odometry::Impl {
     for (DetectionResult& result : detections->Collect(frame, &stats->detector_wait_seconds)) {
       DetectionEvent& event = stats->detections.emplace_back();
       event.result = std::move(result);
+      const auto keyframe = KeyframeOf(event.result.keyframe);
+      event.keyframe_gone = event.result.error.empty() && keyframe == tracks.keyframes.end();
       if (!event.result.error.empty()) {
         if (detections_failed++ == 0) {
           PDVO_LOG(Warning) << "vo: the plane detector failed at the keyframe of frame " << event.result.keyframe
                             << " (" << event.result.error << "); going on without its planes (said once)";
         }
-        continue;
+      } else if (!event.keyframe_gone) {
+        event.seeding = SeedDetectedPlanes(event.result.planes, keyframe->first, frame, camera, o.pdvo, o.features,
+                                           o.prior.inverse_depth_sigma / o.prior.inverse_depth, o.prior.inverse_depth,
+                                           filter.get(), &tracks, &record);
       }
-      const auto keyframe = KeyframeOf(event.result.keyframe);
-      event.keyframe_gone = keyframe == tracks.keyframes.end();
-      if (event.keyframe_gone) continue;
-      event.seeding = SeedDetectedPlanes(event.result.planes, keyframe->first, frame, camera, o.pdvo, o.features,
-                                         o.prior.inverse_depth_sigma / o.prior.inverse_depth, o.prior.inverse_depth,
-                                         filter.get(), &tracks, &record);
+      tracks.RemoveOutOfView(filter.get(), &record);  // the planes waiting for it that it did not carry on
     }
     if (stats->keyframe) {
       detections->Offer(

@@ -42,6 +42,7 @@ PlaneGrower::PlaneGrower(const Camera& camera, const PlaneOptions& planes, const
 void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const {
   std::vector<int> to_points, empty;
   for (auto& [id, t] : tracks->planes) {
+    if (t.out_of_view) continue;  // it waits for the next detection (plane_priors.h)
     ++t.age;
     std::erase_if(t.members, [&](const PlanePoint& m) { return Tracks::Gone(m.history, features_); });
     if (t.members.empty()) {

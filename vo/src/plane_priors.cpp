@@ -55,6 +55,7 @@ std::vector<Eigen::Vector2d> PlanarPixelsInKeyframe(const Filter& filter, const 
                                                     const Camera& camera) {
   std::vector<Eigen::Vector2d> out;
   for (const auto& [id, t] : tracks.planes) {
+    if (t.out_of_view) continue;
     for (const MemberInKeyframe& m : MembersInKeyframe(filter, id, t, reference, camera, 0)) out.push_back(m.pixel);
   }
   return out;
@@ -124,7 +125,7 @@ int PlaneToExtend(const Filter& filter, const Tracks& tracks, int reference, con
   int best = -1, best_inside = 0;
   for (const auto& [id, t] : tracks.planes) {
     const Filter::Plane& plane = filter.planes().at(id);
-    if (plane.reference == reference) continue;
+    if (plane.reference == reference || t.out_of_view) continue;
     const std::vector<MemberInKeyframe> seen = MembersInKeyframe(filter, id, t, reference, camera, 0);
     const int inside = static_cast<int>(std::count_if(
         seen.begin(), seen.end(), [&](const MemberInKeyframe& m) { return InsidePolygon(polygon, m.pixel); }));
@@ -135,6 +136,27 @@ int PlaneToExtend(const Filter& filter, const Tracks& tracks, int reference, con
     if (seen_normal.dot(normal) < std::cos(o.max_extend_angle * M_PI / 180)) continue;
     best = id;
     best_inside = inside;
+  }
+  return best;
+}
+
+// The plane waiting out of view (PlaneTrack::out_of_view) that a detection in keyframe `reference` with unit
+// normal `normal` carries on: the one whose normal, seen from the keyframe, is nearest the detected one, within
+// max_extend_angle, and whose front the keyframe sees. -1 if none.
+int WaitingPlaneFor(const Filter& filter, const Tracks& tracks, int reference, const Eigen::Vector3d& normal,
+                    const PdvoOptions& o) {
+  int best = -1;
+  double best_cos = std::cos(o.max_extend_angle * M_PI / 180);
+  for (const auto& [id, t] : tracks.planes) {
+    if (!t.out_of_view) continue;
+    const Filter::Plane& plane = filter.planes().at(id);
+    const InversePlane seen = plane.plane.InFrame(filter.references().at(plane.reference).world_from_cam.Inverse() *
+                                                  filter.references().at(reference).world_from_cam);
+    const double c = seen.normal.normalized().dot(normal);
+    if (seen.inverse_distance > 0 && c >= best_cos) {
+      best = id;
+      best_cos = c;
+    }
   }
   return best;
 }
@@ -176,7 +198,6 @@ bool MovePlaneToKeyframe(int id, int reference, const Camera& camera, int border
                          MapRecord* record, std::set<int>* candidates) {
   PlaneTrack& track = tracks->planes.at(id);
   const std::vector<MemberInKeyframe> seen = MembersInKeyframe(*filter, id, track, reference, camera, border);
-  if (seen.empty()) return false;
   const int old_reference = filter->planes().at(id).reference;
   MapPlane so_far;
   const bool mapped = PlaneInWorld(*filter, id, track, record->min_plane_points(), &so_far);
@@ -277,15 +298,24 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       ++out.grazing;
       continue;
     }
-    const double rho_p = PlaneInverseDistance(*filter, *tracks, reference, polygon, n, seed->pixel, ray, o.min_facing,
-                                              default_inverse_depth);
+    // A plane waiting out of view with this orientation carries on here, from the seed, as a new plane would
+    // (its growth starts again: plane_grow_frames to reach min_plane_points in this keyframe).
+    int id = WaitingPlaneFor(*filter, *tracks, reference, n, o);
+    if (id >= 0 && MovePlaneToKeyframe(id, reference, camera, features.border, filter, tracks, record, &candidates)) {
+      tracks->planes.at(id).out_of_view = false;
+      tracks->planes.at(id).age = 0;
+      ++out.extended;
+    } else {
+      const double rho_p = PlaneInverseDistance(*filter, *tracks, reference, polygon, n, seed->pixel, ray, o.min_facing,
+                                                default_inverse_depth);
+      id = filter->AddPlane(reference, {n, rho_p}, o.normal_sigma, relative_prior_sigma * rho_p);
+      ++out.seeded;
+    }
     seed->used = true;
-    const int id = filter->AddPlane(reference, {n, rho_p}, o.normal_sigma, relative_prior_sigma * rho_p);
     PlaneTrack& track = tracks->planes[id];
     track.members.push_back({seed->pixel, ray, {}});
     TakeRegion(polygon, detected, std::move(region), reference, frame, o, *filter, tracks, &candidates, &track);
     planar.push_back(seed->pixel);
-    ++out.seeded;
   }
   return out;
 }

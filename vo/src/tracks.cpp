@@ -86,16 +86,31 @@ void Tracks::LeaveView(const Camera& camera, int border, Filter* filter, MapReco
   }
   RemovePoints(gone, filter, record);
   gone.clear();
-  for (const auto& [id, t] : planes) {
+  std::vector<int> waiting;
+  for (auto& [id, t] : planes) {
     const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
       return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border);
     });
-    if (!any) gone.push_back(id);
+    if (!any) record->Record(id, t);
+    t.out_of_view =
+        !any && t.detected && static_cast<int>(t.members.size()) + t.moved_away >= record->min_plane_points();
+    if (t.out_of_view) {
+      waiting.push_back(id);
+    } else if (!any) {
+      gone.push_back(id);
+    }
   }
-  for (int id : gone) {
-    record->Record(id, planes.at(id));
-    RemovePlane(id, filter, record);
+  // Beyond kMaxOutOfViewPlanes, the oldest planes (ids grow with time) leave first.
+  for (size_t k = 0; k + kMaxOutOfViewPlanes < waiting.size(); ++k) gone.push_back(waiting[k]);
+  for (int id : gone) RemovePlane(id, filter, record);
+}
+
+void Tracks::RemoveOutOfView(Filter* filter, MapRecord* record) {
+  std::vector<int> gone;
+  for (const auto& [id, t] : planes) {
+    if (t.out_of_view) gone.push_back(id);
   }
+  for (int id : gone) RemovePlane(id, filter, record);
 }
 
 void Tracks::LeaveRejected(const FeatureOptions& options, Filter* filter, MapRecord* record) {

@@ -12,7 +12,11 @@
 // the keyframe sees, with a normal that agrees, extends that plane instead: the plane moves to the keyframe
 // (Filter::MovePlane; its points become the keyframe's rays and pixels) and grows in the polygon as a new one
 // would. A surface that stays in view is then one plane however many keyframes see it, as one map plane should
-// be, not a new plane per keyframe. Pixels are the keyframe's working image.
+// be, not a new plane per keyframe. A detected plane whose points have all left the view (the road, passed by)
+// waits out of the measurements until the next detection (Tracks::LeaveView): a detection that would be seeded,
+// with a normal within max_extend_angle of the waiting plane's, carries that plane on instead (moved to the
+// keyframe, seeded and grown there as a new plane would be); waiting planes that no detection carried on leave
+// then (the odometry calls Tracks::RemoveOutOfView after each detection). Pixels are the keyframe's working image.
 #pragma once
 
 #include <vector>
@@ -77,7 +81,8 @@ struct PdvoOptions {
 struct SeedingOutcome {
   int detected = 0;
   int seeded = 0;
-  int extended = 0;    // an older plane's points are inside the polygon: it moved here and grows in the polygon
+  int extended = 0;    // an older plane moved here and grows in the polygon: its points are inside it, or it
+                       // waited out of view with this orientation
   int small = 0;       // polygon smaller than min_area, or score below min_score
   int too_many = 0;    // max_planes were seeded already (from larger detections)
   int near_plane = 0;  // centroid within min_plane_distance of a planar point visible in the keyframe

@@ -112,7 +112,13 @@ struct PlaneTrack {
   // Points that left it when it moved to a later keyframe that does not see them (plane_priors.h): mapped, they
   // count among its points as the members out of view of a plane that stays do.
   int moved_away = 0;
+  // A detected plane none of whose points is in view waits, out of the measurements, for the next detection
+  // (plane_priors.h): one whose normal agrees carries it on in its keyframe; else it leaves then.
+  bool out_of_view = false;
 };
+
+// Planes waiting out of view, at most (the detector being slow, they would otherwise gather).
+inline constexpr int kMaxOutOfViewPlanes = 4;
 
 // The features of one filter, by the filter's ids, and the keyframes they come from. Every point and plane of
 // the filter has a track here and every reference camera a keyframe; Remove* keeps it so.
@@ -131,8 +137,12 @@ struct Tracks {
   // camera has left the filter goes too.
   void RemovePoints(const std::vector<int>& ids, Filter* filter, MapRecord* record);
   void RemovePlane(int id, Filter* filter, MapRecord* record);
-  // Features out of view (or behind the camera) leave; a plane leaves when none of its points is in view.
+  // Features out of view (or behind the camera) leave; a plane leaves when none of its points is in view, but
+  // a detected plane that has min_plane_points waits out of view (PlaneTrack::out_of_view; at most
+  // kMaxOutOfViewPlanes, the oldest leave first).
   void LeaveView(const Camera& camera, int border, Filter* filter, MapRecord* record);
+  // The planes waiting out of view leave.
+  void RemoveOutOfView(Filter* filter, MapRecord* record);
   // Points whose history says they leave (Gone).
   void LeaveRejected(const FeatureOptions& options, Filter* filter, MapRecord* record);
 };
