@@ -120,14 +120,20 @@ int main(int argc, char** argv) {
   Eigen::Quaterniond key_truth = walk.front().world_from_cam.rotation;
   int nees_frames = 0, nees_inside = 0;
   struct Member {  // a plane's point in view, for the purity below
-    int frame, plane, keyframe;
+    int frame, segment, plane, keyframe;
     Eigen::Vector2d keyframe_pixel;
   };
   std::vector<Member> members;
   // The filter fixes the orientation of the camera it starts at (the gauge), the first frame's and again the
   // frame of a restart (bootstrap or lost): the truth is compared in that camera's frame.
   Eigen::Quaterniond gauge = walk.front().world_from_cam.rotation.conjugate();
-  std::map<std::pair<int, int>, Eigen::Vector3d> normals;  // (keyframe, plane id): its last normal, keyframe frame
+  // Per plane (segment, id: a restart's filter numbers its planes again): its last normal and the keyframe (frame
+  // index) of whose camera frame it is; a plane that moved to a later keyframe is one plane.
+  struct LastNormal {
+    int keyframe = 0;
+    Eigen::Vector3d normal;
+  };
+  std::map<std::pair<int, int>, LastNormal> normals;
   int detected = 0, seeded = 0, extended = 0, dropped = 0;
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadSeconds();
@@ -179,11 +185,11 @@ int main(int argc, char** argv) {
     for (const pdvo::vo::Observation& o : odometry.observations()) {
       if (o.plane >= 0) {
         const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
-        members.push_back({static_cast<int>(k), o.plane, keyframe, o.keyframe_pixel});
+        members.push_back({static_cast<int>(k), s.segment, o.plane, keyframe, o.keyframe_pixel});
         measured_after.Add(static_cast<int>(k), keyframe, o.plane, o.keyframe_pixel, o.used);
         const auto plane = odometry.filter().planes().find(o.plane);
         if (plane != odometry.filter().planes().end()) {
-          normals[{keyframe, o.plane}] = plane->second.plane.normal.normalized();
+          normals[{s.segment, o.plane}] = {keyframe, plane->second.plane.normal.normalized()};
         }
       }
     }
@@ -200,9 +206,9 @@ int main(int argc, char** argv) {
   // on their plane's most common surface.
   std::map<int, cv::Mat> surfaces;  // by keyframe: the true ids
   pdvo::PlanePurity purity;
-  // Per mapped plane (keyframe, id): the true planes under its points, and its points' keyframe pixels.
+  // Per mapped plane (segment, id): the true planes under its points, and its points (keyframe and pixel).
   std::map<std::pair<int, int>, std::map<int, int>> true_planes;
-  std::map<std::pair<int, int>, std::set<std::pair<int, int>>> plane_pixels;
+  std::map<std::pair<int, int>, std::set<std::array<int, 3>>> plane_pixels;
   for (const Member& m : members) {
     cv::Mat& id = surfaces[m.keyframe];
     if (id.empty()) {
@@ -212,11 +218,12 @@ int main(int argc, char** argv) {
     }
     const int at = id.at<int>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
     purity.Add(m.frame, m.plane, at >= 0 ? street.planes.at(at).surface : -1);
-    ++true_planes[{m.keyframe, m.plane}][at];
-    plane_pixels[{m.keyframe, m.plane}].insert({cvRound(m.keyframe_pixel.x()), cvRound(m.keyframe_pixel.y())});
+    ++true_planes[{m.segment, m.plane}][at];
+    plane_pixels[{m.segment, m.plane}].insert(
+        {m.keyframe, cvRound(m.keyframe_pixel.x()), cvRound(m.keyframe_pixel.y())});
   }
   // Normal error: each plane of min_plane_points or more against the true plane under most of its points, in the
-  // keyframe's camera frame (the estimated keyframe orientation's error is part of it).
+  // camera frame of the keyframe it was last in (the estimated keyframe orientation's error is part of it).
   std::vector<double> normal_errors;
   for (const auto& [key, votes] : true_planes) {
     if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points || !normals.count(key)) {
@@ -225,9 +232,10 @@ int main(int argc, char** argv) {
     const auto main =
         std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
     if (main->first < 0) continue;
+    const LastNormal& last = normals.at(key);
     const Eigen::Vector3d truth =
-        walk.at(key.first).world_from_cam.rotation.conjugate() * street.planes.at(main->first).normal;
-    const double c = std::min(1.0, std::abs(truth.normalized().dot(normals.at(key))));
+        walk.at(last.keyframe).world_from_cam.rotation.conjugate() * street.planes.at(main->first).normal;
+    const double c = std::min(1.0, std::abs(truth.normalized().dot(last.normal)));
     normal_errors.push_back(std::acos(c) * 180 / M_PI);
   }
   std::sort(normal_errors.begin(), normal_errors.end());
