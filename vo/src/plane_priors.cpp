@@ -193,11 +193,13 @@ std::vector<int> RegionCorners(const std::vector<cv::Point2f>& polygon, const Pd
 // Plane `id` moves to keyframe `reference` (Filter::MovePlane): the map keeps it as it is (its extent so far),
 // its points become rays and pixels of that keyframe (those it does not see at least `border` inside leave it
 // and count as moved away), its candidates of the old keyframe stay points, and the keyframe goes if its
-// reference camera has. False, and nothing changes, if the plane cannot move.
+// reference camera has. False, and nothing changes, if the plane cannot move, or if the keyframe sees none of
+// its points and it is not waiting out of view (a waiting plane moves to be seeded again).
 bool MovePlaneToKeyframe(int id, int reference, const Camera& camera, int border, Filter* filter, Tracks* tracks,
                          MapRecord* record, std::set<int>* candidates) {
   PlaneTrack& track = tracks->planes.at(id);
   const std::vector<MemberInKeyframe> seen = MembersInKeyframe(*filter, id, track, reference, camera, border);
+  if (seen.empty() && !track.out_of_view) return false;
   const int old_reference = filter->planes().at(id).reference;
   MapPlane so_far;
   const bool mapped = PlaneInWorld(*filter, id, track, record->min_plane_points(), &so_far);
