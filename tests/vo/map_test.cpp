@@ -1,4 +1,5 @@
-// The map as PLY: header counts, vertex order (points, plane corners, camera path), faces and path edges.
+// The map as PLY: header counts, vertex order (points, plane corners, camera path), faces (with their plane
+// numbers) and path edges.
 #include "pdvo/vo/map.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +20,8 @@ TEST(Map, WritesPointsPlanesAndPathAsPly) {
   MapPlane plane;
   plane.polygon = {Eigen::Vector3d(0, 0, 4), Eigen::Vector3d(1, 0, 4), Eigen::Vector3d(1, 1, 4)};
   plane.normal = Eigen::Vector3d(0, 0, -1);
+  plane.filter = 2;
+  plane.plane = 7;
   map.planes = {plane};
   Trajectory path;
   for (int k = 0; k < 3; ++k)
@@ -38,7 +41,7 @@ TEST(Map, WritesPointsPlanesAndPathAsPly) {
   EXPECT_EQ(body[0], "1 2 3 200 200 200");
   EXPECT_EQ(body[2], "0 0 4 128 128 0");  // normal (0, 0, -1) as colour
   EXPECT_EQ(body[7], "2 0 0 255 0 0");    // the last camera position
-  EXPECT_EQ(body[8], "3 2 3 4");          // the plane's face: its three corners
+  EXPECT_EQ(body[8], "3 2 3 4 2 7");      // the plane's face: its three corners, its filter and plane numbers
   EXPECT_EQ(body[9], "5 6");              // the path's first step
   EXPECT_EQ(body[10], "6 7");
 
@@ -50,8 +53,20 @@ TEST(Map, WritesPointsPlanesAndPathAsPly) {
   ASSERT_EQ(read.planes[0].polygon.size(), 3u);
   EXPECT_EQ(read.planes[0].polygon[2], plane.polygon[2]);
   EXPECT_LT((read.planes[0].normal - plane.normal).norm(), 0.01);
+  EXPECT_EQ(read.planes[0].filter, 2);
+  EXPECT_EQ(read.planes[0].plane, 7);
   ASSERT_EQ(read_path.size(), 3u);
   EXPECT_EQ(read_path[2], Eigen::Vector3d(2, 0, 0));
+  // A file written before faces had their numbers reads with -1.
+  std::string old = ReadFile(dir / "map.ply");
+  old.erase(old.find("property int filter\nproperty int plane\n"), 39);
+  old.replace(old.find("3 2 3 4 2 7"), 11, "3 2 3 4");
+  WriteFileAtomically(dir / "old.ply", old);
+  const Map read_old = ReadPly(dir / "old.ply", &read_path);
+  ASSERT_EQ(read_old.planes.size(), 1u);
+  EXPECT_EQ(read_old.planes[0].polygon[2], plane.polygon[2]);
+  EXPECT_EQ(read_old.planes[0].plane, -1);
+  EXPECT_EQ(read_path.size(), 3u);
 }
 
 TEST(Map, ReadsAPathOfOnePoseAndRefusesMalformedFiles) {

@@ -346,8 +346,14 @@ TEST(PlanePriors, APlaneOutOfViewIsCarriedOnByTheNextDetectionOfItsOrientation) 
   const std::vector<cv::Point2f> outline = {{60, 40}, {260, 40}, {260, 200}, {60, 200}};
   EXPECT_TRUE(InsidePolygon(outline, t.members[0].keyframe_pixel, s.options.region_margin));
   EXPECT_FALSE(t.region_corners.empty());
-  EXPECT_EQ(s.record.kept().planes.size(), 1u);  // what it mapped before, kept
+  ASSERT_EQ(s.record.kept().planes.size(), 1u);  // what it mapped before, kept
   EXPECT_EQ(s.record.stats().planes, 1);         // one plane, not two
+  // In the map, its polygon before and its polygon now are numbered as one plane.
+  const Map now = CurrentMap(s.filter, s.tracks, 1, s.record.filter_number());
+  ASSERT_EQ(now.planes.size(), 1u);
+  EXPECT_EQ(s.record.kept().planes[0].plane, s.plane);
+  EXPECT_EQ(now.planes[0].plane, s.plane);
+  EXPECT_EQ(s.record.kept().planes[0].filter, now.planes[0].filter);
 }
 
 TEST(PlanePriors, APlaneOutOfViewIsNotCarriedOnByAnotherOrientation) {

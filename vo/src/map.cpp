@@ -44,6 +44,7 @@ bool PlaneInWorld(const Filter& filter, int id, const PlaneTrack& t, int min_poi
     out->polygon.push_back(ref * (t.members[k].ray / rho));
   }
   out->normal = ref.rotation * plane.plane.normal.normalized();
+  out->plane = id;
   return true;
 }
 
@@ -89,9 +90,14 @@ void MapRecord::KeepPlane(const Filter& filter, int id, const PlaneTrack& track)
   if (PlaneInWorld(filter, id, track, min_plane_points_, &plane)) KeepPlane(plane);
 }
 
+void MapRecord::KeepPlane(MapPlane plane) {
+  plane.filter = generation_;
+  kept_.planes.push_back(std::move(plane));
+}
+
 void MapRecord::KeepAll(const Filter& filter, const Tracks& tracks) {
   for (const auto& [id, t] : tracks.planes) Record(id, t);
-  kept_.Append(CurrentMap(filter, tracks, min_plane_points_));
+  kept_.Append(CurrentMap(filter, tracks, min_plane_points_, generation_));
 }
 
 MappingStats MapRecord::stats() const {
@@ -129,7 +135,7 @@ std::vector<double> MeasurementCurve::Mean() const {
   return mean;
 }
 
-Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points) {
+Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points, int filter_number) {
   Map m;
   Eigen::Vector3d x;
   for (const auto& [id, p] : filter.points()) {
@@ -137,7 +143,10 @@ Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points)
   }
   MapPlane plane;
   for (const auto& [id, t] : tracks.planes) {
-    if (PlaneInWorld(filter, id, t, min_plane_points, &plane)) m.planes.push_back(plane);
+    if (PlaneInWorld(filter, id, t, min_plane_points, &plane)) {
+      plane.filter = filter_number;
+      m.planes.push_back(plane);
+    }
   }
   return m;
 }
@@ -152,6 +161,7 @@ void WritePly(const std::string& path, const Map& map, const Trajectory& camera_
       << "element vertex " << vertices << "\nproperty float x\nproperty float y\nproperty float z\n"
       << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
       << "element face " << map.planes.size() << "\nproperty list uchar int vertex_indices\n"
+      << "property int filter\nproperty int plane\n"
       << "element edge " << edges << "\nproperty int vertex1\nproperty int vertex2\nend_header\n";
   auto vertex = [&](const Eigen::Vector3d& x, int r, int g, int b) {
     out << x.x() << " " << x.y() << " " << x.z() << " " << r << " " << g << " " << b << "\n";
@@ -169,7 +179,7 @@ void WritePly(const std::string& path, const Map& map, const Trajectory& camera_
   for (const MapPlane& p : map.planes) {
     out << p.polygon.size();
     for (size_t k = 0; k < p.polygon.size(); ++k) out << " " << next + k;
-    out << "\n";
+    out << " " << p.filter << " " << p.plane << "\n";
     next += p.polygon.size();
   }
   for (size_t k = 0; k < edges; ++k) out << next + k << " " << next + k + 1 << "\n";
@@ -180,6 +190,7 @@ Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path) 
   std::istringstream in(ReadFile(path));
   std::string line, word;
   size_t vertices = 0, faces = 0, edges = 0;
+  bool numbered = false;  // faces carry their filter and plane numbers
   PDVO_THROW_CHECK(std::getline(in, line) && line == "ply", FormatError, path << ": not a PLY file");
   while (std::getline(in, line) && line != "end_header") {
     std::istringstream header(line);
@@ -187,6 +198,8 @@ Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path) 
     size_t count = 0;
     if (header >> word >> kind >> count && word == "element") {
       (kind == "vertex" ? vertices : kind == "face" ? faces : edges) = count;
+    } else if (line == "property int plane") {
+      numbered = true;
     } else if (line.rfind("format", 0) == 0) {
       PDVO_THROW_CHECK(line == "format ascii 1.0", FormatError, path << ": not an ASCII PLY file");
     }
@@ -214,6 +227,8 @@ Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path) 
       in_face[i] = true;
       if (k == 0) plane.normal = (v[i].rgb.cast<double>() / 127.5 - Eigen::Vector3d::Ones()).normalized();
     }
+    PDVO_THROW_CHECK(!numbered || in >> plane.filter >> plane.plane, FormatError,
+                     path << ": face " << f << " is malformed");
   }
   // The camera path comes last: the vertices of its edges, or a single red one.
   size_t cameras = edges > 0 ? edges + 1 : 0;

@@ -418,7 +418,10 @@ Rigid3d Odometry::world_from_cam() const {
 
 Map Odometry::map() const {
   Map m = impl_->record.kept();
-  if (impl_->started) m.Append(CurrentMap(*impl_->filter, impl_->tracks, impl_->o.planes.min_plane_points));
+  if (impl_->started) {
+    m.Append(
+        CurrentMap(*impl_->filter, impl_->tracks, impl_->o.planes.min_plane_points, impl_->record.filter_number()));
+  }
   return m;
 }
 

@@ -22,6 +22,10 @@ struct Tracks;
 struct MapPlane {
   std::vector<Eigen::Vector3d> polygon;              // world, in order around the plane's points' convex hull
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // world, unit
+  // Which plane of the odometry it is: the filter (each start of the odometry is a new one, MapRecord::NewFilter)
+  // and the plane's id in it. The polygons of a plane that moved to later keyframes (its extent in each) share
+  // them. -1: not known (a file written before they were).
+  int filter = -1, plane = -1;
 };
 
 struct Map {
@@ -68,8 +72,9 @@ class MeasurementCurve {
 
 // True, with its world position, if point `id` of the filter is known to kMappedRelativeSigma.
 bool PointInWorld(const Filter& filter, int id, Eigen::Vector3d* point_in_world);
-// Plane `id` of the filter with track `track` as a polygon in the world; false if it has fewer than
-// `min_points` points or one of its hull's rays does not meet it in front.
+// Plane `id` of the filter with track `track` as a polygon in the world (MapPlane::plane = id; `filter` is left
+// to the caller); false if it has fewer than `min_points` points or one of its hull's rays does not meet it in
+// front.
 bool PlaneInWorld(const Filter& filter, int id, const PlaneTrack& track, int min_points, MapPlane* plane);
 // The convex hull of a plane's points' keyframe pixels, in order around it, and its area (keyframe px^2).
 std::vector<Eigen::Vector2d> PlaneHull(const PlaneTrack& track);
@@ -90,14 +95,16 @@ class MapRecord {
   // Keeps what a feature that leaves the filter has mapped.
   void KeepPoint(const Filter& filter, int id);
   void KeepPlane(const Filter& filter, int id, const PlaneTrack& track);
-  // Keeps a plane's polygon as it is now (a plane that moves to a later keyframe keeps its extent so far).
-  void KeepPlane(const MapPlane& plane) { kept_.planes.push_back(plane); }
+  // Keeps a plane's polygon as it is now (a plane that moves to a later keyframe keeps its extent so far), as the
+  // current filter's.
+  void KeepPlane(MapPlane plane);
   // Keeps everything in the filter now (before a restart).
   void KeepAll(const Filter& filter, const Tracks& tracks);
 
   const Map& kept() const { return kept_; }
   MappingStats stats() const;
   int min_plane_points() const { return min_plane_points_; }
+  int filter_number() const { return generation_; }  // the current filter's (MapPlane::filter)
 
  private:
   int min_plane_points_;
@@ -107,14 +114,16 @@ class MapRecord {
   size_t kept_points_before_ = 0, kept_planes_before_ = 0;  // kept_'s sizes when the filter started
 };
 
-// The features in the filter now, as map entries.
-Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points);
+// The features in the filter now, as map entries; its planes numbered as filter `filter_number`'s.
+Map CurrentMap(const Filter& filter, const Tracks& tracks, int min_plane_points, int filter_number);
 
 // ASCII PLY: vertices (x y z and an RGB colour: points grey, plane corners coloured by their normal, camera
-// positions red), one face per plane polygon, and one edge per step of the camera path. Written atomically.
+// positions red), one face per plane polygon (its vertex indices, then its filter and plane numbers), and one
+// edge per step of the camera path. Written atomically.
 void WritePly(const std::string& path, const Map& map, const Trajectory& camera_path);
-// Reads a file that WritePly wrote: the map (plane normals from their colour, to about half a degree) and the
-// camera path's positions. Throws IoError or FormatError naming the file.
+// Reads a file that WritePly wrote: the map (plane normals from their colour, to about half a degree; faces
+// without the numbers, as written before they were, get -1) and the camera path's positions. Throws IoError or
+// FormatError naming the file.
 Map ReadPly(const std::string& path, std::vector<Eigen::Vector3d>* camera_path);
 
 }  // namespace pdvo::vo
