@@ -208,11 +208,12 @@ TEST(PlanePriors, GrowthStaysInsideThePolygon) {
   EXPECT_EQ(outside_used, 0);
 }
 
-// A wall plane of the first keyframe, with members across it; the camera then moves 1 m right and makes a
-// second keyframe (its own image and corners) whose detection holds most of the members the second keyframe sees.
+// A wall plane of the first keyframe, with members across it; the camera then moves `metres` right (by default 1
+// m: the later keyframe's detection holds most of the members it sees) and makes a second keyframe (its own image
+// and corners).
 struct MovedScene : Scene {
   int plane = -1, later = -1;
-  MovedScene() {
+  explicit MovedScene(double metres = 1) {
     EXPECT_EQ(Seed({Box(20, 20, 300, 220, kFacing)}).seeded, 1);
     plane = tracks.planes.begin()->first;
     PlaneTrack& t = tracks.planes.at(plane);
@@ -222,8 +223,9 @@ struct MovedScene : Scene {
     }
     t.candidates.clear();
     Eigen::VectorXd step = Eigen::VectorXd::Zero(filter.size());
-    step.head<3>() = Eigen::Vector3d(1, 0, 0);
+    step.head<3>() = Eigen::Vector3d(metres, 0, 0);
     filter.Apply(step);
+    tracks.LeaveView(kCamera, features.border, &filter, &record);
     later = filter.AddReference(true);
     Keyframe& k = tracks.keyframes[later];
     k.frame = 40;
@@ -293,39 +295,15 @@ TEST(PlanePriors, AnOlderPlaneIsNotExtendedByADetectionThatDisagrees) {
   }
 }
 
-// The wall plane of the first keyframe, with members across it; the camera then moves 6 m along the wall, where
-// none of them is in view, and makes a later keyframe there.
-struct PassedScene : Scene {
-  int plane = -1, later = -1;
-  PassedScene() {
-    EXPECT_EQ(Seed({Box(20, 20, 300, 220, kFacing)}).seeded, 1);
-    plane = tracks.planes.begin()->first;
-    PlaneTrack& t = tracks.planes.at(plane);
-    for (const Eigen::Vector2d& p :
-         {Eigen::Vector2d(30, 40), Eigen::Vector2d(90, 200), Eigen::Vector2d(200, 60), Eigen::Vector2d(280, 120)}) {
-      t.members.push_back({p, kCamera.Ray(p), {}});
-    }
-    t.candidates.clear();
-    Eigen::VectorXd step = Eigen::VectorXd::Zero(filter.size());
-    step.head<3>() = Eigen::Vector3d(6, 0, 0);
-    filter.Apply(step);
-    tracks.LeaveView(kCamera, features.border, &filter, &record);
-    later = filter.AddReference(true);
-    Keyframe& k = tracks.keyframes[later];
-    k.frame = 70;
-    k.grey = tracks.keyframes.at(reference).grey.clone();
-    for (const Corner& c : tracks.keyframes.at(reference).corners) k.corners.push_back({c.pixel, false});
-  }
-  SeedingOutcome SeedLater(const std::vector<DetectedPlane>& planes) {
-    return SeedDetectedPlanes(planes, later, 74, kCamera, options, features, 1.0, 0.2, &filter, &tracks, &record);
-  }
+// The camera moves 6 m along the wall from the first keyframe, where none of the plane's members is in view: the
+// plane waits, and a later keyframe is made there.
+struct PassedScene : MovedScene {
+  PassedScene() : MovedScene(6) { EXPECT_TRUE(tracks.planes.at(plane).out_of_view); }
 };
 
 TEST(PlanePriors, APlaneOutOfViewIsCarriedOnByTheNextDetectionOfItsOrientation) {
   PassedScene s;
-  ASSERT_TRUE(s.filter.planes().count(s.plane));
   PlaneTrack& waiting = s.tracks.planes.at(s.plane);
-  ASSERT_TRUE(waiting.out_of_view);
   const int age = waiting.age;
   const PlaneOptions planes;
   PlaneGrower(kCamera, planes, s.features, 1.0).Grow(&s.filter, &s.tracks, &s.record);
@@ -341,8 +319,8 @@ TEST(PlanePriors, APlaneOutOfViewIsCarriedOnByTheNextDetectionOfItsOrientation) 
   const PlaneTrack& t = s.tracks.planes.at(s.plane);
   EXPECT_FALSE(t.out_of_view);
   EXPECT_EQ(t.age, 0);
-  ASSERT_EQ(t.members.size(), 1u);  // the seed of the later keyframe; the five earlier ones moved away
-  EXPECT_EQ(t.moved_away, 5);
+  ASSERT_EQ(t.members.size(), 1u);  // the seed of the later keyframe; the six earlier ones moved away
+  EXPECT_EQ(t.moved_away, 6);
   const std::vector<cv::Point2f> outline = {{60, 40}, {260, 40}, {260, 200}, {60, 200}};
   EXPECT_TRUE(InsidePolygon(outline, t.members[0].keyframe_pixel, s.options.region_margin));
   EXPECT_FALSE(t.region_corners.empty());

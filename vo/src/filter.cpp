@@ -222,7 +222,7 @@ bool Filter::MovePlane(int plane_id, int reference) {
   const auto exact = [&](const Reference& r) { return covariance_.middleRows<6>(r.offset).isZero(0); };
   if (!exact(from) || !exact(to)) return false;
   Eigen::Matrix4d j;
-  const InversePlane moved = plane.plane.InFrame(from.world_from_cam.Inverse() * to.world_from_cam, &j);
+  const InversePlane moved = PlaneSeenFrom(plane_id, reference, &j);
   if (!(moved.inverse_distance > 0) || !moved.normal.allFinite()) return false;
   // P <- T P T^T with T the identity but for J on the plane's block.
   const int o = plane.offset;
@@ -234,6 +234,12 @@ bool Filter::MovePlane(int plane_id, int reference) {
   ++references_.at(reference).users;
   Remove({}, {old_reference});
   return true;
+}
+
+InversePlane Filter::PlaneSeenFrom(int plane_id, int reference, Eigen::Matrix4d* jacobian) const {
+  const Plane& plane = planes_.at(plane_id);
+  return plane.plane.InFrame(
+      references_.at(plane.reference).world_from_cam.Inverse() * references_.at(reference).world_from_cam, jacobian);
 }
 
 void Filter::Renumber() {

@@ -130,9 +130,7 @@ int PlaneToExtend(const Filter& filter, const Tracks& tracks, int reference, con
     const int inside = static_cast<int>(std::count_if(
         seen.begin(), seen.end(), [&](const MemberInKeyframe& m) { return InsidePolygon(polygon, m.pixel); }));
     if (inside < o.max_mapped_points || 2 * inside < static_cast<int>(seen.size()) || inside <= best_inside) continue;
-    const Rigid3d plane_ref_from_keyframe = filter.references().at(plane.reference).world_from_cam.Inverse() *
-                                            filter.references().at(reference).world_from_cam;
-    const Eigen::Vector3d seen_normal = plane.plane.InFrame(plane_ref_from_keyframe).normal.normalized();
+    const Eigen::Vector3d seen_normal = filter.PlaneSeenFrom(id, reference).normal.normalized();
     if (seen_normal.dot(normal) < std::cos(o.max_extend_angle * M_PI / 180)) continue;
     best = id;
     best_inside = inside;
@@ -149,9 +147,7 @@ int WaitingPlaneFor(const Filter& filter, const Tracks& tracks, int reference, c
   double best_cos = std::cos(o.max_extend_angle * M_PI / 180);
   for (const auto& [id, t] : tracks.planes) {
     if (!t.out_of_view) continue;
-    const Filter::Plane& plane = filter.planes().at(id);
-    const InversePlane seen = plane.plane.InFrame(filter.references().at(plane.reference).world_from_cam.Inverse() *
-                                                  filter.references().at(reference).world_from_cam);
+    const InversePlane seen = filter.PlaneSeenFrom(id, reference);
     const double c = seen.normal.normalized().dot(normal);
     if (seen.inverse_distance > 0 && c >= best_cos) {
       best = id;

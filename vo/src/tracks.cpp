@@ -91,7 +91,7 @@ void Tracks::LeaveView(const Camera& camera, int border, Filter* filter, MapReco
     const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
       return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border);
     });
-    if (!any) record->Record(id, t);
+    if (!any && !t.out_of_view) record->Record(id, t);  // as it leaves, or as it starts to wait (then unchanged)
     t.out_of_view =
         !any && t.detected && static_cast<int>(t.members.size()) + t.moved_away >= record->min_plane_points();
     if (t.out_of_view) {

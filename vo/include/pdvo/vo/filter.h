@@ -127,6 +127,9 @@ class Filter {
   // no other feature. Both cameras' poses must be exact (fixed references, AddReference); false, and nothing
   // changes, if they are not, or if the new camera does not see the plane's front.
   bool MovePlane(int plane, int reference);
+  // Plane `plane` as reference camera `reference` sees it (InversePlane::InFrame; `jacobian` with both cameras
+  // taken as exact).
+  InversePlane PlaneSeenFrom(int plane, int reference, Eigen::Matrix4d* jacobian = nullptr) const;
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
   // if the point is behind the camera.
