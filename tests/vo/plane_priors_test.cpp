@@ -225,7 +225,7 @@ struct MovedScene : Scene {
     Eigen::VectorXd step = Eigen::VectorXd::Zero(filter.size());
     step.head<3>() = Eigen::Vector3d(metres, 0, 0);
     filter.Apply(step);
-    tracks.LeaveView(kCamera, features.border, &filter, &record);
+    tracks.LeaveView(kCamera, features, &filter, &record);
     later = filter.AddReference(true);
     Keyframe& k = tracks.keyframes[later];
     k.frame = 40;

@@ -1,5 +1,6 @@
 // Feature bookkeeping and frame preparation: features out of view leave the filter (what they mapped is kept,
-// and a keyframe goes with its last feature's reference camera), detected planes wait out of view; features with
+// and a keyframe goes with its last feature's reference camera), or wait (points up to max_waiting, detected
+// planes) to be measured again when they come back into view; features with
 // a bad history leave; frames are undistorted, resized and converted to grey for the working camera, and frames
 // of another size are refused.
 #include "pdvo/vo/tracks.h"
@@ -32,7 +33,9 @@ TEST(Tracks, FeaturesOutOfViewLeave) {
   const int alone = filter.AddPoint(second, kCamera.Ray({5, 5}), 0.25, 1.0);  // not known: not mapped
   tracks.points[alone] = {{5, 5}, {}};
   EXPECT_EQ(tracks.Visible(filter, kCamera, 10).size(), 1u);
-  tracks.LeaveView(kCamera, 10, &filter, &record);
+  FeatureOptions leave_at_once;
+  leave_at_once.max_waiting = 0;
+  tracks.LeaveView(kCamera, leave_at_once, &filter, &record);
   EXPECT_EQ(filter.points().size(), 1u);
   EXPECT_TRUE(filter.points().count(in_view));
   EXPECT_EQ(tracks.points.size(), 1u);
@@ -45,6 +48,37 @@ TEST(Tracks, FeaturesOutOfViewLeave) {
   tracks.LeaveRejected(options, &filter, &record);
   EXPECT_TRUE(filter.points().empty());
   EXPECT_TRUE(tracks.keyframes.empty());
+}
+
+TEST(Tracks, PointsOutOfViewWaitUpToMaxWaitingAndComeBack) {
+  Filter filter(CameraState(), Matrix12d::Identity() * 1e-8);
+  Tracks tracks;
+  MapRecord record(4);
+  const int reference = filter.AddReference(true);
+  tracks.keyframes[reference] = {};
+  auto point = [&](const Eigen::Vector2d& pixel, const Eigen::Vector3d& ray) {
+    const int id = filter.AddPoint(reference, ray, 0.25, 0.01);
+    tracks.points[id] = {pixel, {}};
+    return id;
+  };
+  // Three points just right of the view (x 330-334 of 320), oldest first, and one behind the camera.
+  std::vector<int> right;
+  for (int k = 0; k < 3; ++k) right.push_back(point({330.0 + 2 * k, 120}, kCamera.Ray({330.0 + 2 * k, 120})));
+  const int behind = point({160, 120}, -kCamera.Ray({160, 120}));
+  FeatureOptions options;
+  options.max_waiting = 2;
+  tracks.LeaveView(kCamera, options, &filter, &record);
+  EXPECT_FALSE(filter.points().count(behind));    // behind the camera: leaves at once
+  EXPECT_FALSE(filter.points().count(right[0]));  // the oldest beyond max_waiting
+  EXPECT_TRUE(filter.points().count(right[1]) && filter.points().count(right[2]));
+  EXPECT_TRUE(tracks.Visible(filter, kCamera, options.border).empty());  // waiting, not in view
+  // The camera turns right by 0.11 rad (about 30 px): the waiting points are in view again, and stay.
+  Eigen::VectorXd turn = Eigen::VectorXd::Zero(filter.size());
+  turn[4] = 0.11;
+  filter.Apply(turn);
+  EXPECT_EQ(tracks.Visible(filter, kCamera, options.border).size(), 2u);
+  tracks.LeaveView(kCamera, options, &filter, &record);
+  EXPECT_EQ(filter.points().size(), 2u);
 }
 
 TEST(Tracks, DetectedPlanesOutOfViewWaitBlindOnesLeave) {
@@ -67,7 +101,7 @@ TEST(Tracks, DetectedPlanesOutOfViewWaitBlindOnesLeave) {
   const int blind = plane(false, 5), small = plane(true, 3);
   std::vector<int> waiting;
   for (int k = 0; k < kMaxOutOfViewPlanes + 1; ++k) waiting.push_back(plane(true, 4));
-  tracks.LeaveView(kCamera, 10, &filter, &record);
+  tracks.LeaveView(kCamera, FeatureOptions{}, &filter, &record);
   EXPECT_FALSE(filter.planes().count(blind));       // a blind seed leaves, as before
   EXPECT_FALSE(filter.planes().count(small));       // fewer than min_plane_points: no plane to carry on
   EXPECT_FALSE(filter.planes().count(waiting[0]));  // the oldest beyond kMaxOutOfViewPlanes
@@ -81,7 +115,7 @@ TEST(Tracks, DetectedPlanesOutOfViewWaitBlindOnesLeave) {
   PlanePoint& back = tracks.planes.at(waiting[1]).members[0];
   back.keyframe_pixel = {160, 120};
   back.ray = kCamera.Ray(back.keyframe_pixel);
-  tracks.LeaveView(kCamera, 10, &filter, &record);
+  tracks.LeaveView(kCamera, FeatureOptions{}, &filter, &record);
   EXPECT_FALSE(tracks.planes.at(waiting[1]).out_of_view);
   tracks.RemoveOutOfView(&filter, &record);
   EXPECT_EQ(filter.planes().size(), 1u);

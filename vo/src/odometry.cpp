@@ -94,7 +94,7 @@ struct Odometry::Impl {
       stats.keyframe = true;
     } else {
       filter->Predict(timestamp - last_time, o.motion.Scaled(adaptation));
-      tracks.LeaveView(camera, o.features.border, filter.get(), &record);
+      tracks.LeaveView(camera, o.features, filter.get(), &record);
       const Search search = SearchFeatures(grey, &stats);
       const RobustUpdateResult update = UpdateRobustly(camera, o.ransac, search.matches, &rng, filter.get());
       Tally(search, update, &stats);
@@ -266,7 +266,7 @@ struct Odometry::Impl {
     };
     for (const auto& [id, p] : filter->points()) {
       if (stats->attempted >= o.features.max_measurements) break;
-      if (!filter->PredictPoint(camera, id, &pixel, &jacobian)) continue;
+      if (!filter->PredictPoint(camera, id, &pixel, &jacobian) || !Inside(pixel, size, o.features.border)) continue;
       const InversePlane patch_plane = FrontoParallel(p.ray, std::max(p.inverse_depth, kMinWarpInverseDepth));
       const Eigen::Matrix3d h =
           PlaneHomography(camera, current, filter->references().at(p.reference).world_from_cam, patch_plane);
@@ -312,7 +312,9 @@ struct Odometry::Impl {
     Eigen::Vector2d pixel;
     Eigen::Vector3d x;
     for (const auto& [id, p] : filter->points()) {
-      if (!PointInWorld(*filter, id, &x) || !filter->PredictPoint(camera, id, &pixel, nullptr)) continue;
+      if (!PointInWorld(*filter, id, &x) || !filter->PredictPoint(camera, id, &pixel, nullptr) ||
+          !Inside(pixel, cv::Size(camera.width, camera.height), 0))
+        continue;
       out.push_back({pixel, 1 / (cam_from_world * x).norm()});
     }
     return out;

@@ -10,7 +10,7 @@ namespace pdvo::vo {
 
 bool FeatureOptions::Check() const {
   PDVO_CHECK_OPTION(max_measurements >= 1 && min_features >= 1 && new_features >= 1 && min_distance >= 1);
-  PDVO_CHECK_OPTION(fast_turnover >= 0);
+  PDVO_CHECK_OPTION(fast_turnover >= 0 && max_waiting >= 0);
   PDVO_CHECK_OPTION(border >= 1 && max_misses >= 1 && min_rejections >= 1 && max_rejected_share >= 0);
   return true;
 }
@@ -77,16 +77,23 @@ void Tracks::RemovePlane(int id, Filter* filter, MapRecord* record) {
   if (!filter->references().count(reference)) keyframes.erase(reference);
 }
 
-void Tracks::LeaveView(const Camera& camera, int border, Filter* filter, MapRecord* record) {
+void Tracks::LeaveView(const Camera& camera, const FeatureOptions& options, Filter* filter, MapRecord* record) {
   const cv::Size size(camera.width, camera.height);
+  const int border = options.border;
   Eigen::Vector2d pixel;
-  std::vector<int> gone;
+  std::vector<int> gone, waiting;
   for (const auto& [id, p] : filter->points()) {
-    if (!filter->PredictPoint(camera, id, &pixel, nullptr) || !Inside(pixel, size, border)) gone.push_back(id);
+    if (!filter->PredictPoint(camera, id, &pixel, nullptr)) {
+      gone.push_back(id);
+    } else if (!Inside(pixel, size, border)) {
+      waiting.push_back(id);
+    }
   }
+  // Beyond max_waiting, the oldest points (ids grow with time) leave first.
+  for (size_t k = 0; k + options.max_waiting < waiting.size(); ++k) gone.push_back(waiting[k]);
   RemovePoints(gone, filter, record);
   gone.clear();
-  std::vector<int> waiting;
+  waiting.clear();
   for (auto& [id, t] : planes) {
     const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
       return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border);

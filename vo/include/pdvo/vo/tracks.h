@@ -28,6 +28,10 @@ struct FeatureOptions {
   double min_distance = 12;  // px between features at initialisation
   int border = 10;           // px: features nearer the image border leave
   int max_misses = 3;        // failed searches in a row before a feature leaves
+  // Points whose predictions have left the view wait, out of the measurements, to be measured again if they come
+  // back; beyond this many, the oldest leave. 0: a point leaves as it leaves the view. From a car, 80 carries the
+  // scale further; hand-held (TUM fr1) it costs rotation accuracy (docs/odometry.md).
+  int max_waiting = 0;
   // A feature also leaves when the robust update has rejected at least min_rejections of its matches and more
   // than max_rejected_share of them (its patch straddles a depth edge or slides on a repetition).
   int min_rejections = 3;
@@ -42,6 +46,7 @@ struct FeatureOptions {
     visit("min_distance", self.min_distance);
     visit("border", self.border);
     visit("max_misses", self.max_misses);
+    visit("max_waiting", self.max_waiting);
     visit("min_rejections", self.min_rejections);
     visit("max_rejected_share", self.max_rejected_share);
   }
@@ -137,10 +142,10 @@ struct Tracks {
   // camera has left the filter goes too.
   void RemovePoints(const std::vector<int>& ids, Filter* filter, MapRecord* record);
   void RemovePlane(int id, Filter* filter, MapRecord* record);
-  // Features out of view (or behind the camera) leave; a plane leaves when none of its points is in view, but
-  // a detected plane that has min_plane_points waits out of view (PlaneTrack::out_of_view; at most
-  // kMaxOutOfViewPlanes, the oldest leave first).
-  void LeaveView(const Camera& camera, int border, Filter* filter, MapRecord* record);
+  // Points behind the camera leave, and points out of view (`options.border`) beyond options.max_waiting (the
+  // oldest first); a plane leaves when none of its points is in view, but a detected plane that has min_plane_points
+  // waits out of view (PlaneTrack::out_of_view; at most kMaxOutOfViewPlanes, the oldest leave first).
+  void LeaveView(const Camera& camera, const FeatureOptions& options, Filter* filter, MapRecord* record);
   // The planes waiting out of view leave.
   void RemoveOutOfView(Filter* filter, MapRecord* record);
   // Points whose history says they leave (Gone).
