@@ -1,9 +1,10 @@
 #!/bin/bash
-# The odometry on the real excerpts (TUM fr1/rpy at 320x240, KITTI 06) as a mean over an ensemble of runs whose
-# measurement noise (search.pixel_sigma) is moved by up to 8% around its default: a single run of these short
-# sequences moves by half a degree with any small change of the options (docs/experiments), so that comparing two
-# settings by one run each says little. Prints one row per run and mode and the means (ATE after Sim(3), rotation
-# RMS); the largest fr1 rotation error of the ensemble in brackets.
+# The odometry (modes points, idpp and pdvo) on the real excerpts (TUM fr1/rpy at 320x240, KITTI 06) as means
+# over an ensemble of runs whose measurement noise (search.pixel_sigma) is moved by up to 8% around its default: a
+# single run of these short sequences moves by half a degree with any small change of the options
+# (docs/experiments/2026-12-05-waiting-points.md), so that comparing two settings by one run each says little.
+# Prints one row per run and the means per mode (ATE after Sim(3), rotation RMS; the largest fr1 rotation error of
+# the ensemble in brackets). About a minute.
 # Usage: bench/vo_real_ensemble.sh [DATA_DIR (default ../shared/data)] [option=value ...  (passed as --set)]
 # e.g.   bench/vo_real_ensemble.sh ../shared/data features.max_waiting=80
 set -euo pipefail
@@ -25,7 +26,7 @@ ate() {
   $pdvo ate --est "$out/trajectory.txt" "$@" -v warning 2>/dev/null |
     awk '/^ATE translation/ { t = $4 } /^ATE rotation/ { r = $4 } END { print t, r }'
 }
-for mode in points idpp; do
+for mode in points idpp pdvo; do
   for sigma in 0.46 0.48 0.49 0.50 0.51 0.52 0.54; do
     options=(--mode "$mode" -v error --set search.pixel_sigma=$sigma "${sets[@]}")
     $pdvo vo -s "$fr1" -o "$work/fr1" -c config/cameras/tum_fr1.yaml "${options[@]}" >/dev/null ||
