@@ -18,18 +18,27 @@ namespace {
 
 const Camera kCamera = Camera::Pinhole(320, 240, 277, 277, 159.5, 119.5);
 
-TEST(Tracks, FeaturesOutOfViewLeave) {
-  Filter filter(CameraState(), Matrix12d::Identity() * 1e-8);
+// A filter at rest with one reference camera (fixed) and its keyframe; more references with AddKeyframe.
+struct Scene {
+  Filter filter{CameraState(), Matrix12d::Identity() * 1e-8};
   Tracks tracks;
-  MapRecord record(4);
-  const int first = filter.AddReference(true);
-  tracks.keyframes[first] = {};
+  MapRecord record{4};
+  int reference = AddKeyframe();
+  int AddKeyframe() {
+    const int id = filter.AddReference(true);
+    tracks.keyframes[id] = {};
+    return id;
+  }
+};
+
+TEST(Tracks, FeaturesOutOfViewLeave) {
+  Scene scene;
+  auto& [filter, tracks, record, first] = scene;
   const int in_view = filter.AddPoint(first, kCamera.Ray({160, 120}), 0.25, 0.01);  // known: mapped when it leaves
   const int near_border = filter.AddPoint(first, kCamera.Ray({315, 120}), 0.25, 0.01);
   tracks.points[in_view] = {{160, 120}, {}};
   tracks.points[near_border] = {{315, 120}, {}};
-  const int second = filter.AddReference(true);
-  tracks.keyframes[second] = {};
+  const int second = scene.AddKeyframe();
   const int alone = filter.AddPoint(second, kCamera.Ray({5, 5}), 0.25, 1.0);  // not known: not mapped
   tracks.points[alone] = {{5, 5}, {}};
   EXPECT_EQ(tracks.Visible(filter, kCamera, 10).size(), 1u);
@@ -51,11 +60,8 @@ TEST(Tracks, FeaturesOutOfViewLeave) {
 }
 
 TEST(Tracks, PointsOutOfViewWaitUpToMaxWaitingAndComeBack) {
-  Filter filter(CameraState(), Matrix12d::Identity() * 1e-8);
-  Tracks tracks;
-  MapRecord record(4);
-  const int reference = filter.AddReference(true);
-  tracks.keyframes[reference] = {};
+  Scene scene;
+  auto& [filter, tracks, record, reference] = scene;
   auto point = [&](const Eigen::Vector2d& pixel, const Eigen::Vector3d& ray) {
     const int id = filter.AddPoint(reference, ray, 0.25, 0.01);
     tracks.points[id] = {pixel, {}};
@@ -82,11 +88,8 @@ TEST(Tracks, PointsOutOfViewWaitUpToMaxWaitingAndComeBack) {
 }
 
 TEST(Tracks, DetectedPlanesOutOfViewWaitBlindOnesLeave) {
-  Filter filter(CameraState(), Matrix12d::Identity() * 1e-8);
-  Tracks tracks;
-  MapRecord record(4);
-  const int reference = filter.AddReference(true);
-  tracks.keyframes[reference] = {};
+  Scene scene;
+  auto& [filter, tracks, record, reference] = scene;
   // Planes 5 m ahead whose members the camera sees only at the left border: out of view.
   auto plane = [&](bool detected, int members) {
     const int id = filter.AddPlane(reference, {Eigen::Vector3d(0, 0, -1), 0.2}, 0.1, 0.01);

@@ -81,19 +81,18 @@ void Tracks::LeaveView(const Camera& camera, const FeatureOptions& options, Filt
   const cv::Size size(camera.width, camera.height);
   const int border = options.border;
   Eigen::Vector2d pixel;
-  std::vector<int> gone, waiting;
+  std::vector<int> gone, waiting_points, waiting_planes;
   for (const auto& [id, p] : filter->points()) {
     if (!filter->PredictPoint(camera, id, &pixel, nullptr)) {
       gone.push_back(id);
     } else if (!Inside(pixel, size, border)) {
-      waiting.push_back(id);
+      waiting_points.push_back(id);
     }
   }
   // Beyond max_waiting, the oldest points (ids grow with time) leave first.
-  for (size_t k = 0; k + options.max_waiting < waiting.size(); ++k) gone.push_back(waiting[k]);
+  for (size_t k = 0; k + options.max_waiting < waiting_points.size(); ++k) gone.push_back(waiting_points[k]);
   RemovePoints(gone, filter, record);
   gone.clear();
-  waiting.clear();
   for (auto& [id, t] : planes) {
     const bool any = std::any_of(t.members.begin(), t.members.end(), [&, id = id](const PlanePoint& m) {
       return filter->PredictPlanePoint(camera, id, m.ray, &pixel, nullptr) && Inside(pixel, size, border);
@@ -102,13 +101,13 @@ void Tracks::LeaveView(const Camera& camera, const FeatureOptions& options, Filt
     t.out_of_view =
         !any && t.detected && static_cast<int>(t.members.size()) + t.moved_away >= record->min_plane_points();
     if (t.out_of_view) {
-      waiting.push_back(id);
+      waiting_planes.push_back(id);
     } else if (!any) {
       gone.push_back(id);
     }
   }
   // Beyond kMaxOutOfViewPlanes, the oldest planes (ids grow with time) leave first.
-  for (size_t k = 0; k + kMaxOutOfViewPlanes < waiting.size(); ++k) gone.push_back(waiting[k]);
+  for (size_t k = 0; k + kMaxOutOfViewPlanes < waiting_planes.size(); ++k) gone.push_back(waiting_planes[k]);
   for (int id : gone) RemovePlane(id, filter, record);
 }
 
