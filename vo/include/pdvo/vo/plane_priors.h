@@ -44,9 +44,10 @@ struct PdvoOptions {
   // of the detected one, that plane is extended (moved to the keyframe, to grow in the polygon); else dropped.
   int max_mapped_points = 3;
   double max_extend_angle = 10;
-  // The prior standard deviation of each component of a detected (unit) normal (about 9 degrees; the shipped
-  // model's matched planes are 2-3 degrees off on held-out streets, more on real images: docs/detector.md).
-  double normal_sigma = 0.15;
+  // The prior standard deviation of each component of a detected (unit) normal (about 2 degrees a component; the
+  // shipped model's matched planes are a median 3 degrees off on held-out streets, more on real images:
+  // docs/detector.md; measured against 0.05 and 0.15 in docs/experiments/2026-12-05-waiting-points.md).
+  double normal_sigma = 0.03;
   int new_plane_points = 10;  // candidates a detected plane takes a frame (the paper)
   int region_corners = 60;    // new corners looked for inside each detected polygon, at most
   // px: a plane's points are taken at least this far inside its polygon (corners cluster on the outlines, where
