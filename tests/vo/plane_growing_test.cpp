@@ -1,6 +1,7 @@
 // Plane growing's parts on known depths: the 3D consistency test accepts a point on the plane and refuses one a
 // metre behind it, or one of another reference camera; a grown frame lets a known candidate on the plane join
-// (fused into the plane, its point leaving the filter) and one off it stay a point; a plane that does not grow
+// (fused into the plane, its point leaving the filter) and one off it stay a point; a candidate waits until its
+// depth is known to the plane's share (stricter for a detected plane); a plane that does not grow
 // becomes a point. The IDPP seeder seeds where corners are densest, apart, facing the camera.
 #include "pdvo/vo/plane_growing.h"
 
@@ -42,8 +43,9 @@ TEST(PlaneGrowing, TheThreeDTestOnKnownDepths) {
   const int other = w.filter.AddReference(true);
   const int elsewhere = w.filter.AddPoint(other, kCamera.Ray({200, 100}), 0.2, 0.01);
   EXPECT_FALSE(PassesPlaneTest(w.filter, elsewhere, w.plane, 100));
-  EXPECT_TRUE(KnownForPlaneTest(w.filter, w.filter.points().at(on)));
-  EXPECT_FALSE(KnownForPlaneTest(w.filter, w.filter.points().at(w.Point({60, 60}, 5.0, 0.5))));
+  EXPECT_TRUE(KnownForPlaneTest(w.filter, w.filter.points().at(on), 0.25));
+  EXPECT_FALSE(KnownForPlaneTest(w.filter, w.filter.points().at(on), 0.04));  // known to 5%
+  EXPECT_FALSE(KnownForPlaneTest(w.filter, w.filter.points().at(w.Point({60, 60}, 5.0, 0.5)), 0.25));
 }
 
 TEST(PlaneGrowing, CandidatesJoinOrStayPoints) {
@@ -86,6 +88,33 @@ TEST(PlaneGrowing, CandidatesJoinOrStayPoints) {
   EXPECT_TRUE(tracks.planes.empty());
   EXPECT_TRUE(w.filter.planes().empty());
   EXPECT_EQ(record.stats().planes, 0);  // it never had min_plane_points
+}
+
+// A candidate takes the 3D test only once its inverse depth is known to the plane's share: a blind seed's
+// (planes.known_inverse_depth, 0.25), or a detected plane's own (pdvo.known_inverse_depth).
+TEST(PlaneGrowing, CandidatesWaitUntilTheirDepthIsKnownToThePlanesShare) {
+  for (const bool detected : {false, true}) {
+    Wall w;
+    PlaneOptions options;
+    options.candidate_frames = 1;
+    const FeatureOptions features;
+    const PlaneGrower grower(kCamera, options, features, 1.0);
+    Tracks tracks;
+    MapRecord record(options.min_plane_points);
+    tracks.keyframes[w.reference].grey = cv::Mat(240, 320, CV_8U, cv::Scalar(0));
+    PlaneTrack& t = tracks.planes[w.plane];
+    const Eigen::Vector2d seed(160, 120);
+    t.members.push_back({seed, kCamera.Ray(seed), {}});
+    t.detected = detected;
+    t.known_share = 0.12;
+    // On the wall, known to 20%: enough for a blind seed, not for the detected plane.
+    const int on = w.Point({180, 120}, 5.0, 0.2);
+    tracks.points[on] = {{180, 120}, {}};
+    t.candidates = {{on, 0}};
+    grower.Grow(&w.filter, &tracks, &record);
+    EXPECT_EQ(tracks.planes.at(w.plane).members.size(), detected ? 1u : 2u) << "detected " << detected;
+    EXPECT_EQ(tracks.planes.at(w.plane).candidates.size(), detected ? 1u : 0u) << "detected " << detected;
+  }
 }
 
 TEST(PlaneSeeder, SeedsWhereCornersAreDensest) {

@@ -10,13 +10,13 @@ namespace pdvo::vo {
 bool PlaneOptions::Check() const {
   PDVO_CHECK_OPTION(max_new_planes >= 0 && grow_radius > 0 && new_plane_points >= 1);
   PDVO_CHECK_OPTION(candidate_frames >= 1 && plane_grow_frames >= 1 && min_plane_points >= 3);
-  PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0 && join_gate > 0);
+  PDVO_CHECK_OPTION(plane_sigma_normal > 0 && planarity > 0 && join_gate > 0 && known_inverse_depth > 0);
   return true;
 }
 
-bool KnownForPlaneTest(const Filter& filter, const Filter::Point& p) {
+bool KnownForPlaneTest(const Filter& filter, const Filter::Point& p, double share) {
   const double sigma = std::sqrt(filter.covariance()(p.offset, p.offset));
-  return p.inverse_depth > 0 && sigma < kKnownRelativeSigma * p.inverse_depth;
+  return p.inverse_depth > 0 && sigma < share * p.inverse_depth;
 }
 
 double InverseDepthVariance(const Filter& filter, const Filter::Plane& plane, const Eigen::Vector3d& ray) {
@@ -50,10 +50,11 @@ void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const 
       continue;
     }
     std::vector<Candidate> waiting;
+    const double known = t.detected ? t.known_share : o_.known_inverse_depth;
     for (Candidate& c : t.candidates) {
       if (!filter->points().count(c.point)) continue;  // left the view or was lost
       ++c.age;
-      if (!KnownForPlaneTest(*filter, filter->points().at(c.point)) || c.age < o_.candidate_frames) {
+      if (!KnownForPlaneTest(*filter, filter->points().at(c.point), known) || c.age < o_.candidate_frames) {
         if (c.age < o_.plane_grow_frames) waiting.push_back(c);
         continue;  // otherwise it stays an ordinary point
       }

@@ -12,7 +12,7 @@ namespace pdvo::vo {
 
 bool PdvoOptions::Check() const {
   PDVO_CHECK_OPTION(delay_frames >= 1 && timeout_seconds > 0 && min_plane_distance >= 0 && min_area >= 0);
-  PDVO_CHECK_OPTION(normal_sigma > 0 && new_plane_points >= 1 && region_corners >= 0);
+  PDVO_CHECK_OPTION(normal_sigma > 0 && new_plane_points >= 1 && region_corners >= 0 && known_inverse_depth > 0);
   PDVO_CHECK_OPTION(min_facing > 0 && min_facing < 1 && max_extend_angle >= 0 && max_extend_angle <= 180);
   return true;
 }
@@ -166,6 +166,7 @@ void TakeRegion(const std::vector<cv::Point2f>& polygon, const DetectedPlane& de
   track->region_corners = std::move(region);
   track->outline = detected.polygon;
   track->new_points = o.new_plane_points;
+  track->known_share = o.known_inverse_depth;
   const int age = frame - tracks->keyframes.at(reference).frame;
   for (const auto& [point, p] : tracks->points) {
     if (filter.points().at(point).reference == reference && !candidates->count(point) &&

@@ -26,6 +26,9 @@ struct PlaneOptions {
   int min_plane_points = 4;         // a plane with fewer is not a plane (not mapped, not counted)
   double plane_sigma_normal = 0.5;  // prior standard deviation of each component of a seeded (unit) normal
   double planarity = 0.02;          // a joining point's distance off its plane, as a share of its inverse depth
+  // A candidate takes the 3D test once its inverse depth is known to this share of itself (one standard
+  // deviation); a detected plane's candidates by pdvo.known_inverse_depth instead.
+  double known_inverse_depth = 0.25;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -38,16 +41,15 @@ struct PlaneOptions {
     visit("min_plane_points", self.min_plane_points);
     visit("plane_sigma_normal", self.plane_sigma_normal);
     visit("planarity", self.planarity);
+    visit("known_inverse_depth", self.known_inverse_depth);
   }
   bool Check() const;
   bool operator==(const PlaneOptions&) const = default;
 };
 
-// A candidate's inverse depth is known, for the 3D test, within this share of itself (one standard deviation).
-inline constexpr double kKnownRelativeSigma = 0.25;
-
-// True if a point's inverse depth is known well enough for the 3D test (to kKnownRelativeSigma, positive).
-bool KnownForPlaneTest(const Filter& filter, const Filter::Point& point);
+// True if a point's inverse depth is positive and known to `share` of itself (one standard deviation): well
+// enough for the 3D test.
+bool KnownForPlaneTest(const Filter& filter, const Filter::Point& point, double share);
 // The 3D consistency test of point `point` against plane `plane`: they share a reference camera, the plane meets
 // the point's ray in front, and the point's inverse depth and the plane's along the ray agree within `gate`
 // standard deviations of their difference (first order in (n, rho_p)). `on_plane` (if given) becomes the

@@ -49,7 +49,11 @@ struct PdvoOptions {
   // docs/detector.md; measured against 0.05 and 0.15 in docs/experiments/2026-12-05-waiting-points.md).
   double normal_sigma = 0.03;
   int new_plane_points = 10;  // candidates a detected plane takes a frame (the paper)
-  int region_corners = 60;    // new corners looked for inside each detected polygon, at most
+  // A candidate of a detected plane takes the 3D test once its inverse depth is known to this share of itself
+  // (IDPP's blind seeds: planes.known_inverse_depth, 0.25). Stricter, because the detected outline lets in
+  // points of whatever stands in front of the plane: docs/experiments/2026-12-05-pdvo-speed-and-planes.md.
+  double known_inverse_depth = 0.12;
+  int region_corners = 60;  // new corners looked for inside each detected polygon, at most
   // px: a plane's points are taken at least this far inside its polygon (corners cluster on the outlines, where
   // surfaces meet, and a detected outline is a few pixels off).
   double region_margin = 8;
@@ -70,6 +74,7 @@ struct PdvoOptions {
     visit("max_extend_angle", self.max_extend_angle);
     visit("normal_sigma", self.normal_sigma);
     visit("new_plane_points", self.new_plane_points);
+    visit("known_inverse_depth", self.known_inverse_depth);
     visit("region_corners", self.region_corners);
     visit("region_margin", self.region_margin);
     visit("min_facing", self.min_facing);
