@@ -7,7 +7,8 @@
 // median of what their inverse depths say, given the normal; the nearest point's if fewer than three; the
 // odometry's prior if none). Its candidates are the keyframe's points inside the polygon (tracked since the
 // keyframe) and new corners found inside it, at least region_margin from the outline; it takes up to
-// new_plane_points of them a frame, each through the 3D consistency test (plane_growing.h).
+// new_plane_points of them a frame, each through the 3D consistency test (plane_growing.h) once its inverse
+// depth is known to known_inverse_depth.
 // A detection whose polygon holds most of the points of one older plane (anchored at an earlier keyframe) that
 // the keyframe sees, with a normal that agrees, extends that plane instead: the plane moves to the keyframe
 // (Filter::MovePlane; its points become the keyframe's rays and pixels) and grows in the polygon as a new one
