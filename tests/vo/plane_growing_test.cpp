@@ -54,7 +54,7 @@ TEST(PlaneGrowing, CandidatesJoinOrStayPoints) {
   options.candidate_frames = 1;
   options.new_plane_points = 2;
   const FeatureOptions features;
-  const PlaneGrower grower(kCamera, options, features, 1.0);
+  const PlaneGrower grower(kCamera, options, {}, features, 1.0);
   Tracks tracks;
   MapRecord record(options.min_plane_points);
   Keyframe& keyframe = tracks.keyframes[w.reference];
@@ -98,7 +98,7 @@ TEST(PlaneGrowing, CandidatesWaitUntilTheirDepthIsKnownToThePlanesShare) {
     PlaneOptions options;
     options.candidate_frames = 1;
     const FeatureOptions features;
-    const PlaneGrower grower(kCamera, options, features, 1.0);
+    const PlaneGrower grower(kCamera, options, {.new_points = 1, .known_inverse_depth = 0.12}, features, 1.0);
     Tracks tracks;
     MapRecord record(options.min_plane_points);
     tracks.keyframes[w.reference].grey = cv::Mat(240, 320, CV_8U, cv::Scalar(0));
@@ -106,7 +106,6 @@ TEST(PlaneGrowing, CandidatesWaitUntilTheirDepthIsKnownToThePlanesShare) {
     const Eigen::Vector2d seed(160, 120);
     t.members.push_back({seed, kCamera.Ray(seed), {}});
     t.detected = detected;
-    t.known_share = 0.12;
     // On the wall, known to 20%: enough for a blind seed, not for the detected plane.
     const int on = w.Point({180, 120}, 5.0, 0.2);
     tracks.points[on] = {{180, 120}, {}};

@@ -94,7 +94,6 @@ TEST(PlanePriors, SeedsAtTheCornerNearestTheCentroidWithTheDetectedNormal) {
   for (const auto& [point, t] : s.tracks.points) inside += InsidePolygon(outline, t.keyframe_pixel, 8);
   EXPECT_EQ(static_cast<int>(track.candidates.size()), inside);
   for (const Candidate& c : track.candidates) EXPECT_EQ(c.age, 4);
-  EXPECT_EQ(track.new_points, s.options.new_plane_points);
   // Its inverse distance: the median of what the points on the wall say with the detected normal,
   // rho_p = -rho / (n . m).
   std::vector<double> says;
@@ -185,7 +184,7 @@ TEST(PlanePriors, GrowthStaysInsideThePolygon) {
   const std::vector<cv::Point2f> outline = {{40, 40}, {150, 40}, {150, 200}, {40, 200}};
   const int id = s.tracks.planes.begin()->first;
   PlaneOptions planes;
-  const PlaneGrower grower(kCamera, planes, s.features, 1.0);
+  const PlaneGrower grower(kCamera, planes, s.options.Growth(), s.features, 1.0);
   MapRecord record(planes.min_plane_points);
   size_t before = s.filter.points().size();
   for (int frame = 0; frame < 3; ++frame) {
@@ -306,7 +305,7 @@ TEST(PlanePriors, APlaneOutOfViewIsCarriedOnByTheNextDetectionOfItsOrientation) 
   PlaneTrack& waiting = s.tracks.planes.at(s.plane);
   const int age = waiting.age;
   const PlaneOptions planes;
-  PlaneGrower(kCamera, planes, s.features, 1.0).Grow(&s.filter, &s.tracks, &s.record);
+  PlaneGrower(kCamera, planes, s.options.Growth(), s.features, 1.0).Grow(&s.filter, &s.tracks, &s.record);
   EXPECT_EQ(s.tracks.planes.at(s.plane).age, age);  // a waiting plane does not grow (nor age)
   const InversePlane before = s.filter.planes().at(s.plane).plane;
   const SeedingOutcome o = s.SeedLater({Box(60, 40, 260, 200, kFacing)});

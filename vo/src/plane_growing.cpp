@@ -35,9 +35,13 @@ bool PassesPlaneTest(const Filter& filter, int point, int plane_id, double gate,
   return rho > 0 && std::abs(p.inverse_depth - rho) < gate * std::sqrt(variance + plane_variance);
 }
 
-PlaneGrower::PlaneGrower(const Camera& camera, const PlaneOptions& planes, const FeatureOptions& features,
-                         double relative_prior_sigma)
-    : camera_(camera), o_(planes), features_(features), relative_prior_sigma_(relative_prior_sigma) {}
+PlaneGrower::PlaneGrower(const Camera& camera, const PlaneOptions& planes, const DetectedGrowth& detected,
+                         const FeatureOptions& features, double relative_prior_sigma)
+    : camera_(camera),
+      o_(planes),
+      detected_(detected),
+      features_(features),
+      relative_prior_sigma_(relative_prior_sigma) {}
 
 void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const {
   std::vector<int> to_points, empty;
@@ -50,7 +54,7 @@ void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const 
       continue;
     }
     std::vector<Candidate> waiting;
-    const double known = t.detected ? t.known_share : o_.known_inverse_depth;
+    const double known = t.detected ? detected_.known_inverse_depth : o_.known_inverse_depth;
     for (Candidate& c : t.candidates) {
       if (!filter->points().count(c.point)) continue;  // left the view or was lost
       ++c.age;
@@ -86,7 +90,7 @@ void PlaneGrower::AddCandidates(int id, Filter* filter, Tracks* tracks) const {
   const Filter::Plane& plane = filter->planes().at(id);
   PlaneTrack& t = tracks->planes.at(id);
   std::vector<Corner>& corners = tracks->keyframes.at(plane.reference).corners;
-  const int wanted = t.detected ? t.new_points : o_.new_plane_points;
+  const int wanted = t.detected ? detected_.new_points : o_.new_plane_points;
   const size_t count = t.detected ? t.region_corners.size() : corners.size();
   int added = 0;
   for (size_t i = 0; i < count && added < wanted; ++i) {

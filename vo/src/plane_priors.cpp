@@ -165,8 +165,6 @@ void TakeRegion(const std::vector<cv::Point2f>& polygon, const DetectedPlane& de
   track->detected = true;
   track->region_corners = std::move(region);
   track->outline = detected.polygon;
-  track->new_points = o.new_plane_points;
-  track->known_share = o.known_inverse_depth;
   const int age = frame - tracks->keyframes.at(reference).frame;
   for (const auto& [point, p] : tracks->points) {
     if (filter.points().at(point).reference == reference && !candidates->count(point) &&

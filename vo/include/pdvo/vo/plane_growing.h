@@ -27,7 +27,7 @@ struct PlaneOptions {
   double plane_sigma_normal = 0.5;  // prior standard deviation of each component of a seeded (unit) normal
   double planarity = 0.02;          // a joining point's distance off its plane, as a share of its inverse depth
   // A candidate takes the 3D test once its inverse depth is known to this share of itself (one standard
-  // deviation); a detected plane's candidates by pdvo.known_inverse_depth instead.
+  // deviation); a detected plane's candidates by DetectedGrowth::known_inverse_depth instead.
   double known_inverse_depth = 0.25;
 
   template <class Self, class V>
@@ -58,11 +58,19 @@ bool PassesPlaneTest(const Filter& filter, int point, int plane, double gate, do
 // The variance of the inverse depth at which `ray` (unit, reference frame) meets the plane.
 double InverseDepthVariance(const Filter& filter, const Filter::Plane& plane, const Eigen::Vector3d& ray);
 
+// How a detected plane (PlaneTrack::detected) grows, from mode pdvo's options (plane_priors.h): candidates a
+// frame (pdvo.new_plane_points) and how well a candidate's inverse depth is known before its 3D test
+// (pdvo.known_inverse_depth).
+struct DetectedGrowth {
+  int new_points = 0;
+  double known_inverse_depth = 0;
+};
+
 class PlaneGrower {
  public:
   // `relative_prior_sigma`: a candidate's inverse-depth prior standard deviation as a share of the prior.
-  PlaneGrower(const Camera& camera, const PlaneOptions& planes, const FeatureOptions& features,
-              double relative_prior_sigma);
+  PlaneGrower(const Camera& camera, const PlaneOptions& planes, const DetectedGrowth& detected,
+              const FeatureOptions& features, double relative_prior_sigma);
 
   // One frame of growth for every plane of `tracks` (after the frame's update): tests the candidates that are
   // old and known enough, adds new candidates, demotes planes that did not grow, records the planes' sizes.
@@ -70,12 +78,13 @@ class PlaneGrower {
 
  private:
   // Up to new_plane_points candidates for plane `id` from its keyframe's unused corners within grow_radius of
-  // a member (a detected plane: up to its new_points, from its region_corners) and at least min_distance from
-  // all of them.
+  // a member (a detected plane: up to DetectedGrowth::new_points, from its region_corners) and at least min_distance
+  // from all of them.
   void AddCandidates(int id, Filter* filter, Tracks* tracks) const;
 
   Camera camera_;
   PlaneOptions o_;
+  DetectedGrowth detected_;
   FeatureOptions features_;
   double relative_prior_sigma_;
 };

@@ -26,6 +26,7 @@
 #include "pdvo/common/detected_plane.h"
 #include "pdvo/vo/detection_worker.h"
 #include "pdvo/vo/filter.h"
+#include "pdvo/vo/plane_growing.h"
 #include "pdvo/vo/tracks.h"
 
 namespace pdvo::vo {
@@ -82,6 +83,8 @@ struct PdvoOptions {
   }
   bool Check() const;
   bool operator==(const PdvoOptions&) const = default;
+  // How the planes seeded here grow (PlaneGrower).
+  DetectedGrowth Growth() const { return {new_plane_points, known_inverse_depth}; }
 };
 
 // What became of one keyframe's detected planes.

@@ -108,14 +108,11 @@ struct PlaneTrack {
   std::vector<Candidate> candidates;
   int age = 0;  // frames since the plane was made
   // A detected plane (plane_priors.h) grows from the keyframe corners inside its outline only (indices into its
-  // keyframe's corners), by up to new_points candidates a frame, each tested once its inverse depth is known to
-  // known_share. A blind seed (detected false): from the corners within grow_radius of its members, by the
-  // options' new_plane_points and known_inverse_depth.
+  // keyframe's corners); a blind seed (detected false): from the corners within grow_radius of its members
+  // (PlaneGrower, with each kind's options).
   bool detected = false;
   std::vector<int> region_corners;
   std::vector<Eigen::Vector2d> outline;  // a detected plane's polygon, keyframe pixels
-  int new_points = 0;
-  double known_share = 0;
   // Points that left it when it moved to a later keyframe that does not see them (plane_priors.h): mapped, they
   // count among its points as the members out of view of a plane that stays do.
   int moved_away = 0;
