@@ -46,18 +46,20 @@ function median(list, n,   i, j, t, a) { for (i = 1; i <= n; i++) a[i] = list[i]
   for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
   return n == 0 ? -1 : (n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2) }
 { c = get("name"); n[c]++; planes[c] += get("planes"); ate[c] += get("ate_percent"); fps[c] += get("tracking_fps")
+  surfaces[c] += get("surfaces")
   if (get("planes") > 0) { m[c]++; ppp[c] += get("points_per_plane"); area[c] += get("mean_area") }
   if (get("purity") >= 0) { pn[c]++; pur[c] += get("purity") }
   if (get("normal_median") >= 0) { nn[c]++; normals[c, nn[c]] = get("normal_median") } }
 END {
   printf "\nTable I on %d streets (means; points per plane and area over the streets with planes)\n", n["idpp"]
-  printf "%-8s %8s %10s %10s %8s %12s %9s %10s\n", "mode", "planes", "pts/plane", "area px", "purity", "normal med", "ATE %", "track fps"
+  printf "%-8s %8s %10s %10s %8s %12s %9s %10s %9s\n", "mode", "planes", "pts/plane", "area px", "purity", "normal med", "ATE %", "track fps", "surfaces"
   split("idpp pdvo oracle", order, " ")
   for (k = 1; k <= 3; k++) { c = order[k]; if (!n[c]) continue
     delete l; for (i = 1; i <= nn[c]; i++) l[i] = normals[c, i]
     P[c] = planes[c] / n[c]; Q[c] = m[c] ? ppp[c] / m[c] : 0; A[c] = m[c] ? area[c] / m[c] : 0
     U[c] = pn[c] ? pur[c] / pn[c] : -1; N[c] = median(l, nn[c]); E[c] = ate[c] / n[c]; F[c] = fps[c] / n[c]
-    printf "%-8s %8.1f %10.2f %10.0f %8.3f %12.1f %9.3f %10.0f\n", c, P[c], Q[c], A[c], U[c], N[c], E[c], F[c] }
+    printf "%-8s %8.1f %10.2f %10.0f %8.3f %12.1f %9.3f %10.0f %9.1f\n", c, P[c], Q[c], A[c], U[c], N[c], E[c], F[c], surfaces[c] / n[c] }
+  printf "(surfaces: the true surfaces that are the main one of the points of some plane; coplanar polygons are one surface)\n"
   printf "\nratios to idpp      planes  pts/plane   area   (paper PDVO/IDPP: 0.25, 1.61, 2.41; targets <= 0.5, >= 1.3, >= 1.8)\n"
   for (k = 2; k <= 3; k++) { c = order[k]; if (!n[c] || !P["idpp"]) continue
     printf "%-18s %7.2f %10.2f %6.2f\n", c, P[c] / P["idpp"], Q[c] / Q["idpp"], A[c] / A["idpp"] }

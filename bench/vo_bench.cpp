@@ -225,6 +225,7 @@ int main(int argc, char** argv) {
   // Normal error: each plane of min_plane_points or more against the true plane under most of its points, in the
   // camera frame of the keyframe it was last in (the estimated keyframe orientation's error is part of it).
   std::vector<double> normal_errors;
+  std::set<int> surfaces_mapped;  // the true surfaces that are some such plane's main one
   for (const auto& [key, votes] : true_planes) {
     if (static_cast<int>(plane_pixels[key].size()) < vo_options.planes.min_plane_points || !normals.count(key)) {
       continue;
@@ -232,6 +233,7 @@ int main(int argc, char** argv) {
     const auto main =
         std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
     if (main->first < 0) continue;
+    surfaces_mapped.insert(street.planes.at(main->first).surface);
     const LastNormal& last = normals.at(key);
     const Eigen::Vector3d truth =
         walk.at(last.keyframe).world_from_cam.rotation.conjugate() * street.planes.at(main->first).normal;
@@ -264,8 +266,8 @@ int main(int argc, char** argv) {
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
               mapping.points_per_plane, mapping.mean_plane_area);
   if (!normal_errors.empty()) {
-    std::printf("  plane normals    median error %.1f deg over %zu planes\n", normal_errors[normal_errors.size() / 2],
-                normal_errors.size());
+    std::printf("  plane normals    median error %.1f deg over %zu planes, on %zu true surfaces\n",
+                normal_errors[normal_errors.size() / 2], normal_errors.size(), surfaces_mapped.size());
   }
   if (pdvo_mode) {
     const pdvo::vo::Odometry::DetectionCounts counts = odometry.detection_counts();
@@ -277,11 +279,12 @@ int main(int argc, char** argv) {
   // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
   std::printf(
       "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
-      "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu seeded=%d curve=",
+      "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d curve=",
       static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
       pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
       mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
-      normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(), seeded);
+      normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(),
+      surfaces_mapped.size(), seeded);
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
