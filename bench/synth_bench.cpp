@@ -17,9 +17,7 @@ int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 2000;
   pdvo::sim::SynthOptions options;
   const pdvo::Camera camera = options.MakeCamera();
-  const double length = options.walk.speed * frames / options.walk.fps;
-  const pdvo::sim::Street street = pdvo::sim::GenerateStreet(options.street, length + 30, 1);
-  const pdvo::Trajectory walk = pdvo::sim::WalkStreet(street, options.walk, frames, 1);
+  const auto [street, walk] = pdvo::sim::MakeWalkedStreet(options, frames, 1);
   const pdvo::sim::Renderer renderer(street, camera, options.render, 1);
   std::printf("street: %zu planes, %zu objects, %.0f m; %d frames at %dx%d, one thread\n", street.planes.size(),
               street.blobs.size(), street.Length(), frames, camera.width, camera.height);

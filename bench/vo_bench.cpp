@@ -76,9 +76,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const pdvo::Camera camera = options.MakeCamera();
-  const double length = options.walk.speed * frames / options.walk.fps;
-  const pdvo::sim::Street street = pdvo::sim::GenerateStreet(options.street, length + 30, seed);
-  const pdvo::Trajectory walk = pdvo::sim::WalkStreet(street, options.walk, frames, seed);
+  const auto [street, walk] = pdvo::sim::MakeWalkedStreet(options, frames, seed);
   std::vector<cv::Mat> grey, colour;
   const pdvo::sim::Renderer renderer(street, camera, options.render, seed);
   const pdvo::vo::FramePreparer preparer(camera, vo_options.working_width);  // as pdvo vo prepares frames
@@ -101,11 +99,8 @@ int main(int argc, char** argv) {
     };
   } else if (pdvo_mode && source == "oracle") {
     detect = [&](const pdvo::vo::KeyframeImage& k) {
-      pdvo::sim::RenderedFrame geometry;
-      renderer.RenderGeometry(walk.at(k.frame).world_from_cam, &geometry);
-      const pdvo::Annotation a =
-          pdvo::sim::AnnotateFrame(street, geometry, walk.at(k.frame).world_from_cam, camera, "");
-      return pdvo::DetectedPlanes(a, working.width);
+      return pdvo::DetectedPlanes(pdvo::sim::AnnotateView(street, renderer, walk.at(k.frame).world_from_cam, camera),
+                                  working.width);
     };
   } else if (pdvo_mode) {
     std::fprintf(stderr, "vo_bench: source is model or oracle, not '%s'\n", source.c_str());

@@ -104,15 +104,27 @@ std::vector<Rigid3d> ExposurePoses(const Trajectory& walk, int i, const RenderOp
 }
 }  // namespace
 
+WalkedStreet MakeWalkedStreet(const SynthOptions& options, int frames, uint64_t seed) {
+  WalkedStreet out;
+  out.street = GenerateStreet(options.street, options.walk.speed * frames / options.walk.fps + 30.0, seed);
+  out.walk = WalkStreet(out.street, options.walk, frames, seed);
+  return out;
+}
+
+Annotation AnnotateView(const Street& street, const Renderer& renderer, const Rigid3d& world_from_cam,
+                        const Camera& camera) {
+  RenderedFrame geometry;
+  renderer.RenderGeometry(world_from_cam, &geometry);
+  return AnnotateFrame(street, geometry, world_from_cam, camera, "");
+}
+
 void WriteSynthSequence(const std::string& out_dir, uint64_t seed, int frames, const SynthOptions& options,
                         const std::function<void()>& on_frame) {
   CheckOptionsOrThrow(options, "synth options");
   PDVO_THROW_CHECK(frames > 0, InvalidArgument, "synth: --frames must be positive, got " << frames);
   Camera camera = options.MakeCamera();
   camera.depth_scale = kSynthDepthScale;
-  const double walk_length = options.walk.speed * frames / options.walk.fps;
-  const Street street = GenerateStreet(options.street, walk_length + 30.0, seed);
-  const Trajectory walk = WalkStreet(street, options.walk, frames, seed);
+  const auto [street, walk] = MakeWalkedStreet(options, frames, seed);
   const Renderer renderer(street, camera, options.render, seed);
 
   StagedOutputDir out(out_dir);

@@ -29,8 +29,9 @@ struct Scene {
   explicit Scene(uint64_t seed, int frames = 120, bool loop = false) {
     options.street.loop = loop;
     camera = options.MakeCamera();
-    street = GenerateStreet(options.street, options.walk.speed * frames / options.walk.fps + 30, seed);
-    walk = WalkStreet(street, options.walk, frames, seed);
+    WalkedStreet walked = MakeWalkedStreet(options, frames, seed);
+    street = std::move(walked.street);
+    walk = std::move(walked.walk);
   }
 };
 

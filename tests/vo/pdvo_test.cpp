@@ -91,16 +91,12 @@ TEST(Pdvo, OnFullStreetsTheOraclesPlanesHoldMorePoints) {
   const Camera camera = synth.MakeCamera();
   double idpp_points = 0, idpp_planes = 0, oracle_points = 0, oracle_planes = 0;
   for (const uint64_t seed : {1, 2, 3}) {
-    const double length = synth.walk.speed * kFrames / synth.walk.fps;
-    const sim::Street street = sim::GenerateStreet(synth.street, length + 30, seed);
-    const Trajectory walk = sim::WalkStreet(street, synth.walk, kFrames, seed);
+    const auto [street, walk] = sim::MakeWalkedStreet(synth, kFrames, seed);
     const sim::Renderer renderer(street, camera, synth.render, seed);
     const sim::Renderer oracle_renderer(street, camera, synth.render, seed);  // for the detector's thread
     PlaneDetector oracle = [&](const KeyframeImage& k) {
-      const Rigid3d& pose = walk.at(k.frame).world_from_cam;
-      sim::RenderedFrame geometry;
-      oracle_renderer.RenderGeometry(pose, &geometry);
-      return DetectedPlanes(sim::AnnotateFrame(street, geometry, pose, camera, ""), camera.width);
+      return DetectedPlanes(sim::AnnotateView(street, oracle_renderer, walk.at(k.frame).world_from_cam, camera),
+                            camera.width);
     };
     VoOptions idpp_options;
     idpp_options.mode = PlaneMode::kIdpp;

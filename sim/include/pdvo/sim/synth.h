@@ -54,6 +54,19 @@ struct SynthOptions {
 Annotation AnnotateFrame(const Street& street, const RenderedFrame& frame, const Rigid3d& world_from_cam,
                          const Camera& camera, const std::string& image_path);
 
+// A street long enough for a walk of `frames` frames with 30 m to spare (the view ahead stays on the street), and
+// that walk: what the synthetic sequence of this seed shows.
+struct WalkedStreet {
+  Street street;
+  Trajectory walk;
+};
+WalkedStreet MakeWalkedStreet(const SynthOptions& options, int frames, uint64_t seed);
+
+// The exact annotation of the view from `world_from_cam` (Renderer::RenderGeometry, then AnnotateFrame): what a
+// perfect plane detector would say, the oracle of the odometry's benchmarks.
+Annotation AnnotateView(const Street& street, const Renderer& renderer, const Rigid3d& world_from_cam,
+                        const Camera& camera);
+
 // Renders `frames` frames and writes the folder (staged: nothing is left behind on failure). `on_frame` is
 // called after each frame, for progress.
 void WriteSynthSequence(const std::string& out_dir, uint64_t seed, int frames, const SynthOptions& options,
