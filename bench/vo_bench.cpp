@@ -99,8 +99,7 @@ int main(int argc, char** argv) {
     };
   } else if (pdvo_mode && source == "oracle") {
     detect = [&](const pdvo::vo::KeyframeImage& k) {
-      return pdvo::DetectedPlanes(pdvo::sim::AnnotateView(street, renderer, walk.at(k.frame).world_from_cam, camera),
-                                  working.width);
+      return pdvo::DetectedPlanes(pdvo::sim::AnnotateView(renderer, walk.at(k.frame).world_from_cam), working.width);
     };
   } else if (pdvo_mode) {
     std::fprintf(stderr, "vo_bench: source is model or oracle, not '%s'\n", source.c_str());

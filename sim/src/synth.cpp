@@ -111,11 +111,10 @@ WalkedStreet MakeWalkedStreet(const SynthOptions& options, int frames, uint64_t 
   return out;
 }
 
-Annotation AnnotateView(const Street& street, const Renderer& renderer, const Rigid3d& world_from_cam,
-                        const Camera& camera) {
+Annotation AnnotateView(const Renderer& renderer, const Rigid3d& world_from_cam) {
   RenderedFrame geometry;
   renderer.RenderGeometry(world_from_cam, &geometry);
-  return AnnotateFrame(street, geometry, world_from_cam, camera, "");
+  return AnnotateFrame(renderer.street(), geometry, world_from_cam, renderer.camera(), "");
 }
 
 void WriteSynthSequence(const std::string& out_dir, uint64_t seed, int frames, const SynthOptions& options,

@@ -95,8 +95,7 @@ TEST(Pdvo, OnFullStreetsTheOraclesPlanesHoldMorePoints) {
     const sim::Renderer renderer(street, camera, synth.render, seed);
     const sim::Renderer oracle_renderer(street, camera, synth.render, seed);  // for the detector's thread
     PlaneDetector oracle = [&](const KeyframeImage& k) {
-      return DetectedPlanes(sim::AnnotateView(street, oracle_renderer, walk.at(k.frame).world_from_cam, camera),
-                            camera.width);
+      return DetectedPlanes(sim::AnnotateView(oracle_renderer, walk.at(k.frame).world_from_cam), camera.width);
     };
     VoOptions idpp_options;
     idpp_options.mode = PlaneMode::kIdpp;

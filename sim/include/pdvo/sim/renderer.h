@@ -58,6 +58,7 @@ class Renderer {
   void Render(const std::vector<Rigid3d>& exposure_poses, double time, uint64_t frame_index, RenderedFrame* out) const;
 
   const Camera& camera() const { return camera_; }
+  const Street& street() const { return street_; }
 
  private:
   void Shade(const Rigid3d& world_from_cam, const RenderedFrame& geometry, cv::Mat* colour) const;

@@ -62,10 +62,10 @@ struct WalkedStreet {
 };
 WalkedStreet MakeWalkedStreet(const SynthOptions& options, int frames, uint64_t seed);
 
-// The exact annotation of the view from `world_from_cam` (Renderer::RenderGeometry, then AnnotateFrame): what a
-// perfect plane detector would say, the oracle of the odometry's benchmarks.
-Annotation AnnotateView(const Street& street, const Renderer& renderer, const Rigid3d& world_from_cam,
-                        const Camera& camera);
+// The exact annotation of the renderer's view from `world_from_cam` (Renderer::RenderGeometry, then
+// AnnotateFrame with the renderer's street and camera): what a perfect plane detector would say, the oracle of the
+// odometry's benchmarks.
+Annotation AnnotateView(const Renderer& renderer, const Rigid3d& world_from_cam);
 
 // Renders `frames` frames and writes the folder (staged: nothing is left behind on failure). `on_frame` is
 // called after each frame, for progress.
