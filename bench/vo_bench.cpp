@@ -4,7 +4,9 @@
 // monocular VO observes without scale, against the ground truth expressed in the first camera's frame), and the
 // resident memory of tracking (rendered frames excluded). The NEES takes the camera the filter fixed when it
 // started (the first frame, or the frame of the two-view bootstrap) as exact. In idpp mode, the purity of the
-// planes: how many of their points lie on the same true surface, and the median error of their normals.
+// planes: how many of their points lie on the same true surface, and the median error of their normals. The
+// match accuracy: how many of the matches the filter used lie within 1.5 px of where the true point under the
+// feature's keyframe pixel is seen (the rendered depth; a corner on an occluding edge counts as its pixel's).
 // In pdvo mode the planes come from `source=model` (the detector with the shipped model, or model=PATH) or
 // `source=oracle` (the street's exact annotation of each keyframe); the tracking thread's time is its CPU time
 // (the detector's thread excluded; the deterministic schedule's waits excluded).
@@ -118,6 +120,12 @@ int main(int argc, char** argv) {
     Eigen::Vector2d keyframe_pixel;
   };
   std::vector<Member> members;
+  struct Match {  // a feature found by the search, for the match accuracy below
+    int frame, keyframe;
+    Eigen::Vector2d keyframe_pixel, pixel;
+    bool used;
+  };
+  std::vector<Match> matches;
   // The filter fixes the orientation of the camera it starts at (the gauge), the first frame's and again the
   // frame of a restart (bootstrap or lost): the truth is compared in that camera's frame.
   Eigen::Quaterniond gauge = walk.front().world_from_cam.rotation.conjugate();
@@ -177,8 +185,9 @@ int main(int argc, char** argv) {
       key_truth = walk[k].world_from_cam.rotation;
     }
     for (const pdvo::vo::Observation& o : odometry.observations()) {
+      const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
+      if (o.matched) matches.push_back({static_cast<int>(k), keyframe, o.keyframe_pixel, o.pixel, o.used});
       if (o.plane >= 0) {
-        const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
         members.push_back({static_cast<int>(k), s.segment, o.plane, keyframe, o.keyframe_pixel});
         measured_after.Add(static_cast<int>(k), keyframe, o.plane, o.keyframe_pixel, o.used);
         const auto plane = odometry.filter().planes().find(o.plane);
@@ -198,18 +207,18 @@ int main(int argc, char** argv) {
   // Plane purity: per frame, each plane's members (if 4 or more) by the true surface at their keyframe pixel
   // (coplanar polygons share a surface; non-planar objects and the sky count as one other); the share of them
   // on their plane's most common surface.
-  std::map<int, cv::Mat> surfaces;  // by keyframe: the true ids
+  std::map<int, pdvo::sim::RenderedFrame> geometry;  // by keyframe: the true depths and ids
+  auto geometry_of = [&](int keyframe) -> const pdvo::sim::RenderedFrame& {
+    pdvo::sim::RenderedFrame& g = geometry[keyframe];
+    if (g.id.empty()) renderer.RenderGeometry(walk.at(keyframe).world_from_cam, &g);
+    return g;
+  };
   pdvo::PlanePurity purity;
   // Per mapped plane (segment, id): the true planes under its points, and its points (keyframe and pixel).
   std::map<std::pair<int, int>, std::map<int, int>> true_planes;
   std::map<std::pair<int, int>, std::set<std::array<int, 3>>> plane_pixels;
   for (const Member& m : members) {
-    cv::Mat& id = surfaces[m.keyframe];
-    if (id.empty()) {
-      pdvo::sim::RenderedFrame geometry;
-      renderer.RenderGeometry(walk.at(m.keyframe).world_from_cam, &geometry);
-      id = geometry.id;
-    }
+    const cv::Mat& id = geometry_of(m.keyframe).id;
     const int at = id.at<int>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
     purity.Add(m.frame, m.plane, at >= 0 ? street.planes.at(at).surface : -1);
     ++true_planes[{m.segment, m.plane}][at];
@@ -235,6 +244,32 @@ int main(int argc, char** argv) {
     normal_errors.push_back(std::acos(c) * 180 / M_PI);
   }
   std::sort(normal_errors.begin(), normal_errors.end());
+  // Match accuracy: where each match should have been, the true point under its keyframe pixel (the rendered
+  // depth there) seen from the frame's true pose; the share of the used matches within 1.5 px of it and beyond
+  // 6 px, and of the rejected ones within 1.5 px. Matches of the sky (no depth) are left out.
+  constexpr double kTrueMatch = 1.5, kGrossMatch = 6;
+  long used = 0, used_true = 0, used_gross = 0, rejected = 0, rejected_true = 0;
+  const bool same_pixels = working.width == camera.width && working.height == camera.height;
+  for (const Match& m : matches) {
+    if (!same_pixels) break;  // keyframe pixels are the working camera's, the renderer's differ
+    const float z =
+        geometry_of(m.keyframe).depth.at<float>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
+    if (!(z > 0)) continue;
+    const Eigen::Vector3d world = walk.at(m.keyframe).world_from_cam * (camera.Unproject(m.keyframe_pixel) * z);
+    const Eigen::Vector3d seen = walk.at(m.frame).world_from_cam.Inverse() * world;
+    if (seen.z() <= 0) continue;
+    const double error = (camera.Project(seen) - m.pixel).norm();
+    if (m.used) {
+      ++used;
+      used_true += error < kTrueMatch;
+      used_gross += error > kGrossMatch;
+    } else {
+      ++rejected;
+      rejected_true += error < kTrueMatch;
+    }
+  }
+  const double true_share = used > 0 ? static_cast<double>(used_true) / used : -1;
+  const double gross_share = used > 0 ? static_cast<double>(used_gross) / used : -1;
   // The mean plane's measurements by frames since its keyframe, over the planes of min_plane_points or more.
   const std::vector<double> curve = measured_after.Mean();
   long plane_members = 0;
@@ -254,6 +289,16 @@ int main(int argc, char** argv) {
       "  measurements     %.1f per frame; %d keyframes; lost %d times, %d frames uncertain; two-view "
       "bootstrap at frame %d\n",
       measurements / frames, keyframes, lost, uncertain, bootstrap);
+  if (used > 0) {
+    std::printf(
+        "  match accuracy   %.1f%% of the matches used within %.1f px of the truth, %.1f%% beyond %.0f px; %.1f%% of "
+        "the "
+        "%ld rejected within %.1f px\n",
+        100 * true_share, kTrueMatch, 100 * gross_share, kGrossMatch,
+        rejected > 0 ? 100.0 * rejected_true / rejected : 0.0, rejected, kTrueMatch);
+  } else {
+    std::printf("  match accuracy   not measured (no matches, or working pixels that are not the renderer's)\n");
+  }
   if (plane_members > 0) {
     std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n", pure);
   }
@@ -273,12 +318,13 @@ int main(int argc, char** argv) {
   // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
   std::printf(
       "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
-      "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d curve=",
+      "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d matches_true=%.4f "
+      "matches_gross=%.4f curve=",
       static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
       pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
       mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
       normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(),
-      surfaces_mapped.size(), seeded);
+      surfaces_mapped.size(), seeded, true_share, gross_share);
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
