@@ -249,23 +249,25 @@ int main(int argc, char** argv) {
   // 6 px, and of the rejected ones within 1.5 px. Matches of the sky (no depth) are left out.
   constexpr double kTrueMatch = 1.5, kGrossMatch = 6;
   long used = 0, used_true = 0, used_gross = 0, rejected = 0, rejected_true = 0;
+  // Keyframe pixels are the working camera's: measured only where they are the renderer's.
   const bool same_pixels = working.width == camera.width && working.height == camera.height;
-  for (const Match& m : matches) {
-    if (!same_pixels) break;  // keyframe pixels are the working camera's, the renderer's differ
-    const float z =
-        geometry_of(m.keyframe).depth.at<float>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
-    if (!(z > 0)) continue;
-    const Eigen::Vector3d world = walk.at(m.keyframe).world_from_cam * (camera.Unproject(m.keyframe_pixel) * z);
-    const Eigen::Vector3d seen = walk.at(m.frame).world_from_cam.Inverse() * world;
-    if (seen.z() <= 0) continue;
-    const double error = (camera.Project(seen) - m.pixel).norm();
-    if (m.used) {
-      ++used;
-      used_true += error < kTrueMatch;
-      used_gross += error > kGrossMatch;
-    } else {
-      ++rejected;
-      rejected_true += error < kTrueMatch;
+  if (same_pixels) {
+    for (const Match& m : matches) {
+      const float z =
+          geometry_of(m.keyframe).depth.at<float>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
+      if (!(z > 0)) continue;
+      const Eigen::Vector3d world = walk.at(m.keyframe).world_from_cam * (camera.Unproject(m.keyframe_pixel) * z);
+      const Eigen::Vector3d seen = walk.at(m.frame).world_from_cam.Inverse() * world;
+      if (seen.z() <= 0) continue;
+      const double error = (camera.Project(seen) - m.pixel).norm();
+      if (m.used) {
+        ++used;
+        used_true += error < kTrueMatch;
+        used_gross += error > kGrossMatch;
+      } else {
+        ++rejected;
+        rejected_true += error < kTrueMatch;
+      }
     }
   }
   const double true_share = used > 0 ? static_cast<double>(used_true) / used : -1;
@@ -291,9 +293,8 @@ int main(int argc, char** argv) {
       measurements / frames, keyframes, lost, uncertain, bootstrap);
   if (used > 0) {
     std::printf(
-        "  match accuracy   %.1f%% of the matches used within %.1f px of the truth, %.1f%% beyond %.0f px; %.1f%% of "
-        "the "
-        "%ld rejected within %.1f px\n",
+        "  match accuracy   %.1f%% of the matches used within %.1f px of the truth, %.1f%% beyond %.0f px; "
+        "%.1f%% of the %ld rejected within %.1f px\n",
         100 * true_share, kTrueMatch, 100 * gross_share, kGrossMatch,
         rejected > 0 ? 100.0 * rejected_true / rejected : 0.0, rejected, kTrueMatch);
   } else {
