@@ -6,7 +6,8 @@
 // started (the first frame, or the frame of the two-view bootstrap) as exact. In idpp mode, the purity of the
 // planes: how many of their points lie on the same true surface, and the median error of their normals. The
 // match accuracy: how many of the matches the filter used lie within 1.5 px of where the true point under the
-// feature's keyframe pixel is seen (the rendered depth; a corner on an occluding edge counts as its pixel's).
+// feature's keyframe pixel is seen (the rendered depth; a corner on an occluding edge counts as its pixel's),
+// and their median distance from it.
 // In pdvo mode the planes come from `source=model` (the detector with the shipped model, or model=PATH) or
 // `source=oracle` (the street's exact annotation of each keyframe); the tracking thread's time is its CPU time
 // (the detector's thread excluded; the deterministic schedule's waits excluded).
@@ -249,6 +250,7 @@ int main(int argc, char** argv) {
   // 6 px, and of the rejected ones within 1.5 px. Matches of the sky (no depth) are left out.
   constexpr double kTrueMatch = 1.5, kGrossMatch = 6;
   long used = 0, used_true = 0, used_gross = 0, rejected = 0, rejected_true = 0;
+  std::vector<double> used_errors;  // px
   // Keyframe pixels are the working camera's: measured only where they are the renderer's.
   const bool same_pixels = working.width == camera.width && working.height == camera.height;
   if (same_pixels) {
@@ -262,6 +264,7 @@ int main(int argc, char** argv) {
       const double error = (camera.Project(seen) - m.pixel).norm();
       if (m.used) {
         ++used;
+        used_errors.push_back(error);
         used_true += error < kTrueMatch;
         used_gross += error > kGrossMatch;
       } else {
@@ -270,6 +273,8 @@ int main(int argc, char** argv) {
       }
     }
   }
+  std::sort(used_errors.begin(), used_errors.end());
+  const double median_error = used > 0 ? used_errors[used_errors.size() / 2] : -1;
   const double true_share = used > 0 ? static_cast<double>(used_true) / used : -1;
   const double gross_share = used > 0 ? static_cast<double>(used_gross) / used : -1;
   // The mean plane's measurements by frames since its keyframe, over the planes of min_plane_points or more.
@@ -293,9 +298,9 @@ int main(int argc, char** argv) {
       measurements / frames, keyframes, lost, uncertain, bootstrap);
   if (used > 0) {
     std::printf(
-        "  match accuracy   %.1f%% of the matches used within %.1f px of the truth, %.1f%% beyond %.0f px; "
-        "%.1f%% of the %ld rejected within %.1f px\n",
-        100 * true_share, kTrueMatch, 100 * gross_share, kGrossMatch,
+        "  match accuracy   %.1f%% of the matches used within %.1f px of the truth, %.1f%% beyond %.0f px, median "
+        "error %.2f px; %.1f%% of the %ld rejected within %.1f px\n",
+        100 * true_share, kTrueMatch, 100 * gross_share, kGrossMatch, median_error,
         rejected > 0 ? 100.0 * rejected_true / rejected : 0.0, rejected, kTrueMatch);
   } else {
     std::printf("  match accuracy   not measured (no matches, or working pixels that are not the renderer's)\n");
@@ -320,12 +325,12 @@ int main(int argc, char** argv) {
   std::printf(
       "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
       "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d matches_true=%.4f "
-      "matches_gross=%.4f curve=",
+      "matches_gross=%.4f match_median_px=%.3f curve=",
       static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
       pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
       mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
       normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(),
-      surfaces_mapped.size(), seeded, true_share, gross_share);
+      surfaces_mapped.size(), seeded, true_share, gross_share, median_error);
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
