@@ -16,6 +16,7 @@ bool RenderOptions::Check() const {
   PDVO_CHECK_OPTION(motion_blur_samples >= 1 && motion_blur_samples <= 16);
   PDVO_CHECK_OPTION(exposure_fraction > 0 && exposure_fraction <= 1);
   PDVO_CHECK_OPTION(texels_per_metre >= 5 && texels_per_metre <= 200);
+  PDVO_CHECK_OPTION(supersampling >= 1 && supersampling <= 4);
   return true;
 }
 
@@ -226,6 +227,20 @@ Renderer::Renderer(const Street& street, const Camera& camera, const RenderOptio
   for (int i = 0; i < kNoiseSize * kNoiseSize; ++i) noise_.at<float>(i) = gauss(noise_rng);
   for (int x = 0; x < camera.width; ++x) ray_x_.push_back((x - camera.cx) / camera.fx);
   for (int y = 0; y < camera.height; ++y) ray_y_.push_back((y - camera.cy) / camera.fy);
+  if (options.supersampling > 1) {
+    // Pixel u covers [u - 0.5, u + 0.5]; its k sub-pixels have centres u - 0.5 + (j + 0.5) / k.
+    const int k = options.supersampling;
+    Camera fine = camera;
+    fine.width *= k;
+    fine.height *= k;
+    fine.fx *= k;
+    fine.fy *= k;
+    fine.cx = k * (camera.cx + 0.5) - 0.5;
+    fine.cy = k * (camera.cy + 0.5) - 0.5;
+    RenderOptions single = options;
+    single.supersampling = 1;
+    fine_ = std::make_shared<const Renderer>(street, fine, single, seed);
+  }
 }
 
 void Renderer::RenderGeometry(const Rigid3d& world_from_cam, RenderedFrame* out) const {
@@ -421,12 +436,23 @@ void Renderer::Render(const std::vector<Rigid3d>& exposure_poses, double time, u
   const int w = camera_.width, h = camera_.height;
   cv::Mat colour(h, w, CV_32FC3, cv::Scalar::all(0));
   RenderedFrame blur;
-  for (size_t k = 0; k + 1 < exposure_poses.size(); ++k) {
-    RenderGeometry(exposure_poses[k], &blur);
-    Shade(exposure_poses[k], blur, &colour);
+  if (fine_) {
+    const Camera& f = fine_->camera_;
+    cv::Mat fine_colour(f.height, f.width, CV_32FC3, cv::Scalar::all(0));
+    for (const Rigid3d& pose : exposure_poses) {
+      fine_->RenderGeometry(pose, &blur);
+      fine_->Shade(pose, blur, &fine_colour);
+    }
+    cv::resize(fine_colour, colour, colour.size(), 0, 0, cv::INTER_AREA);
+    RenderGeometry(exposure_poses.back(), out);
+  } else {
+    for (size_t k = 0; k + 1 < exposure_poses.size(); ++k) {
+      RenderGeometry(exposure_poses[k], &blur);
+      Shade(exposure_poses[k], blur, &colour);
+    }
+    RenderGeometry(exposure_poses.back(), out);
+    Shade(exposure_poses.back(), *out, &colour);
   }
-  RenderGeometry(exposure_poses.back(), out);
-  Shade(exposure_poses.back(), *out, &colour);
   const double gain = (1.0 + options_.exposure_variation * std::sin(2 * M_PI * 0.15 * time + exposure_phase_)) /
                       static_cast<double>(exposure_poses.size());
   // Sensor noise from the table, at an offset that changes every frame.

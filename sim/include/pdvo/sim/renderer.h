@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct RenderOptions {
   int motion_blur_samples = 1;      // >1: average this many renders over the exposure
   double exposure_fraction = 0.5;   // exposure time as a fraction of the frame interval (motion blur)
   double texels_per_metre = 25.0;   // texture resolution
+  // >1: each pixel averages supersampling^2 rays (rendered at that multiple of the size, then INTER_AREA), as a
+  // camera's pixel integrates the light over its area; 1: one ray through the pixel's centre (aliased edges).
+  int supersampling = 1;
 
   template <class Self, class V>
   static void Fields(Self& self, V& visit) {
@@ -29,6 +33,7 @@ struct RenderOptions {
     visit("motion_blur_samples", self.motion_blur_samples);
     visit("exposure_fraction", self.exposure_fraction);
     visit("texels_per_metre", self.texels_per_metre);
+    visit("supersampling", self.supersampling);
   }
   bool Check() const;
   bool operator==(const RenderOptions&) const = default;
@@ -72,6 +77,7 @@ class Renderer {
   cv::Mat noise_;                      // CV_32F table of N(0, 1) samples
   std::vector<double> ray_x_, ray_y_;  // per column / row: pinhole ray (x, y, 1)
   double exposure_phase_;
+  std::shared_ptr<const Renderer> fine_;  // supersampling > 1: the same street at that multiple of the size
 };
 
 }  // namespace pdvo::sim
