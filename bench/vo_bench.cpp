@@ -14,11 +14,13 @@
 // Usage: vo_bench [frames] [seed] [option=value ...]   (VoOptions, e.g. mode=idpp search.pixel_sigma=0.5,
 //        and for mode=pdvo source=model|oracle model=PATH; synth=FILE: the street's options, section synth:,
 //        e.g. synth=sim/config/driving.yaml for a car)
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -85,10 +87,11 @@ int main(int argc, char** argv) {
     int frame = 0, segment = 0, plane = 0, keyframe = 0;
     Eigen::Vector2d keyframe_pixel = Eigen::Vector2d::Zero();
   };
-  struct Match {  // a feature found by the search, for the match accuracy below
+  struct Match {  // a feature searched for, for the match accuracy and the searches by age below
     int frame = 0, keyframe = 0;
-    Eigen::Vector2d keyframe_pixel = Eigen::Vector2d::Zero(), pixel = Eigen::Vector2d::Zero();
-    bool used = false;
+    Eigen::Vector2d keyframe_pixel = Eigen::Vector2d::Zero();
+    Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // found, or predicted if not
+    bool found = false, used = false;
   };
   const size_t most = static_cast<size_t>(frames) * vo_options.features.max_measurements;
   std::vector<Member> members(most);
@@ -193,7 +196,7 @@ int main(int argc, char** argv) {
     }
     for (const pdvo::vo::Observation& o : odometry.observations()) {
       const int keyframe = static_cast<int>(std::lround(o.keyframe_time * options.walk.fps));
-      if (o.matched) matches.push_back({static_cast<int>(k), keyframe, o.keyframe_pixel, o.pixel, o.used});
+      matches.push_back({static_cast<int>(k), keyframe, o.keyframe_pixel, o.pixel, o.matched, o.used});
       if (o.plane >= 0) {
         members.push_back({static_cast<int>(k), s.segment, o.plane, keyframe, o.keyframe_pixel});
         measured_after.Add(static_cast<int>(k), keyframe, o.plane, o.keyframe_pixel, o.used);
@@ -257,10 +260,20 @@ int main(int argc, char** argv) {
   constexpr double kTrueMatch = 1.5, kGrossMatch = 6;
   long used = 0, used_true = 0, used_gross = 0, rejected = 0, rejected_true = 0;
   std::vector<double> used_errors;  // px
+  // Searches by the feature's age (frames since its keyframe): how many found it, and of those that did not, how
+  // many were predicted within kNearMiss px of the truth (the patch did not correlate well enough there) or
+  // beyond the search window (the prediction was off).
+  constexpr double kNearMiss = 3;
+  const std::array<int, 5> age_bounds = {1, 2, 5, 10, std::numeric_limits<int>::max()};  // upper bounds
+  std::array<long, 5> searched{}, found{}, missed_near{}, missed_far{};
   // Keyframe pixels are the working camera's: measured only where they are the renderer's.
   const bool same_pixels = working.width == camera.width && working.height == camera.height;
   if (same_pixels) {
     for (const Match& m : matches) {
+      const size_t age =
+          std::lower_bound(age_bounds.begin(), age_bounds.end(), m.frame - m.keyframe) - age_bounds.begin();
+      ++searched[age];
+      found[age] += m.found;
       const float z =
           geometry_of(m.keyframe).depth.at<float>(cvRound(m.keyframe_pixel.y()), cvRound(m.keyframe_pixel.x()));
       if (!(z > 0)) continue;
@@ -268,7 +281,10 @@ int main(int argc, char** argv) {
       const Eigen::Vector3d seen = walk.at(m.frame).world_from_cam.Inverse() * world;
       if (seen.z() <= 0) continue;
       const double error = (camera.Project(seen) - m.pixel).norm();
-      if (m.used) {
+      if (!m.found) {
+        missed_near[age] += error < kNearMiss;
+        missed_far[age] += error > vo_options.search.max_search_radius;
+      } else if (m.used) {
         ++used;
         used_errors.push_back(error);
         used_true += error < kTrueMatch;
@@ -311,6 +327,19 @@ int main(int argc, char** argv) {
   } else {
     std::printf("  match accuracy   not measured (no matches, or working pixels that are not the renderer's)\n");
   }
+  if (same_pixels) {
+    auto row = [&](const char* name, const std::array<long, 5>& count, const std::array<long, 5>& of) {
+      std::printf("    %-24s", name);
+      for (size_t k = 0; k < count.size(); ++k) std::printf(" %5.1f%%", of[k] > 0 ? 100.0 * count[k] / of[k] : 0.0);
+      std::printf("\n");
+    };
+    std::array<long, 5> missed;
+    for (size_t k = 0; k < missed.size(); ++k) missed[k] = searched[k] - found[k];
+    std::printf("  searches by age  frames since the feature's keyframe:  1      2    3-5   6-10    11+\n");
+    row("found", found, searched);
+    row("missed, within 3 px", missed_near, missed);
+    row("missed, beyond window", missed_far, missed);
+  }
   if (plane_members > 0) {
     std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n", pure);
   }
@@ -331,12 +360,13 @@ int main(int argc, char** argv) {
   std::printf(
       "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
       "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d matches_true=%.4f "
-      "matches_gross=%.4f match_median_px=%.3f curve=",
+      "matches_gross=%.4f match_median_px=%.3f found_after_one_frame=%.4f curve=",
       static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
       pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
       mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
       normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(),
-      surfaces_mapped.size(), seeded, true_share, gross_share, median_error);
+      surfaces_mapped.size(), seeded, true_share, gross_share, median_error,
+      searched[0] > 0 ? static_cast<double>(found[0]) / searched[0] : -1.0);
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {
