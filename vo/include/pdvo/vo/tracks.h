@@ -29,8 +29,9 @@ struct FeatureOptions {
   int border = 10;           // px: features nearer the image border leave
   int max_misses = 3;        // failed searches in a row before a feature leaves
   // Points whose predictions have left the view wait, out of the measurements, to be measured again if they come
-  // back; beyond this many, the oldest leave. 0: a point leaves as it leaves the view. From a car, 80 carries the
-  // scale further; hand-held (TUM fr1) it costs rotation accuracy (docs/odometry.md).
+  // back; beyond this many, the oldest leave. 0: a point leaves as it leaves the view. 80 carried the scale
+  // further on aliased driving streets, not on supersampled ones nor on KITTI 06; hand-held (TUM fr1) it costs
+  // rotation accuracy (docs/odometry.md).
   int max_waiting = 0;
   // A feature also leaves when the robust update has rejected at least min_rejections of its matches and more
   // than max_rejected_share of them (its patch straddles a depth edge or slides on a repetition).
