@@ -225,22 +225,29 @@ Renderer::Renderer(const Street& street, const Camera& camera, const RenderOptio
   std::normal_distribution<float> gauss(0, 1);
   std::mt19937 noise_rng(static_cast<uint32_t>(seed));
   for (int i = 0; i < kNoiseSize * kNoiseSize; ++i) noise_.at<float>(i) = gauss(noise_rng);
-  for (int x = 0; x < camera.width; ++x) ray_x_.push_back((x - camera.cx) / camera.fx);
-  for (int y = 0; y < camera.height; ++y) ray_y_.push_back((y - camera.cy) / camera.fy);
+  SetRays();
   if (options.supersampling > 1) {
-    // Pixel u covers [u - 0.5, u + 0.5]; its k sub-pixels have centres u - 0.5 + (j + 0.5) / k.
+    // Pixel u covers [u - 0.5, u + 0.5]; its k sub-pixels have centres u - 0.5 + (j + 0.5) / k. The fine
+    // renderer shares the textures and the noise table (copies of a cv::Mat share its pixels).
     const int k = options.supersampling;
-    Camera fine = camera;
-    fine.width *= k;
-    fine.height *= k;
-    fine.fx *= k;
-    fine.fy *= k;
-    fine.cx = k * (camera.cx + 0.5) - 0.5;
-    fine.cy = k * (camera.cy + 0.5) - 0.5;
-    RenderOptions single = options;
-    single.supersampling = 1;
-    fine_ = std::make_shared<const Renderer>(street, fine, single, seed);
+    auto fine = std::make_shared<Renderer>(*this);
+    fine->camera_.width *= k;
+    fine->camera_.height *= k;
+    fine->camera_.fx *= k;
+    fine->camera_.fy *= k;
+    fine->camera_.cx = k * (camera.cx + 0.5) - 0.5;
+    fine->camera_.cy = k * (camera.cy + 0.5) - 0.5;
+    fine->options_.supersampling = 1;
+    fine->SetRays();
+    fine_ = std::move(fine);
   }
+}
+
+void Renderer::SetRays() {
+  ray_x_.clear();
+  ray_y_.clear();
+  for (int x = 0; x < camera_.width; ++x) ray_x_.push_back((x - camera_.cx) / camera_.fx);
+  for (int y = 0; y < camera_.height; ++y) ray_y_.push_back((y - camera_.cy) / camera_.fy);
 }
 
 void Renderer::RenderGeometry(const Rigid3d& world_from_cam, RenderedFrame* out) const {

@@ -67,6 +67,7 @@ class Renderer {
 
  private:
   void Shade(const Rigid3d& world_from_cam, const RenderedFrame& geometry, cv::Mat* colour) const;
+  void SetRays();  // ray_x_ and ray_y_ from camera_
 
   const Street& street_;
   Camera camera_;
