@@ -281,6 +281,9 @@ TEST(Synth, BadOptionsAreRejected) {
   EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 3, options), InvalidArgument);
   options = SynthOptions();
   EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 0, options), InvalidArgument);
+  options.render.supersampling = 0;
+  EXPECT_THROW(WriteSynthSequence(dir / "x", 1, 3, options), InvalidArgument);
+  options = SynthOptions();
   Camera distorted = options.MakeCamera();
   distorted.distortion[0] = 0.1;
   const Scene s(1, 10);
