@@ -337,7 +337,9 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < missed.size(); ++k) missed[k] = searched[k] - found[k];
     std::printf("  searches by age  frames since the feature's keyframe:  1      2    3-5   6-10    11+\n");
     row("found", found, searched);
-    row("missed, within 3 px", missed_near, missed);
+    char near_name[32];
+    std::snprintf(near_name, sizeof near_name, "missed, within %.0f px", kNearMiss);
+    row(near_name, missed_near, missed);
     row("missed, beyond window", missed_far, missed);
   }
   if (plane_members > 0) {
