@@ -7,7 +7,9 @@
 // planes: how many of their points lie on the same true surface, and the median error of their normals. The
 // match accuracy: how many of the matches the filter used lie within 1.5 px of where the true point under the
 // feature's keyframe pixel is seen (the rendered depth; a corner on an occluding edge counts as its pixel's),
-// and their median distance from it.
+// and their median distance from it. The searches by age: per feature age (frames since its keyframe), the share
+// of searches that found the feature, and of the misses with a truth (not the sky) those predicted within 3 px of
+// it (the patch did not correlate well enough) or beyond the largest search window (the prediction was off).
 // In pdvo mode the planes come from `source=model` (the detector with the shipped model, or model=PATH) or
 // `source=oracle` (the street's exact annotation of each keyframe); the tracking thread's time is its CPU time
 // (the detector's thread excluded; the deterministic schedule's waits excluded).
@@ -260,12 +262,11 @@ int main(int argc, char** argv) {
   constexpr double kTrueMatch = 1.5, kGrossMatch = 6;
   long used = 0, used_true = 0, used_gross = 0, rejected = 0, rejected_true = 0;
   std::vector<double> used_errors;  // px
-  // Searches by the feature's age (frames since its keyframe): how many found it, and of those that did not, how
-  // many were predicted within kNearMiss px of the truth (the patch did not correlate well enough there) or
-  // beyond the search window (the prediction was off).
+  // Searches by the feature's age (frames since its keyframe): how many found it, and of those that did not and
+  // have a truth, how many were predicted within kNearMiss px of it or beyond the largest search window.
   constexpr double kNearMiss = 3;
   const std::array<int, 5> age_bounds = {1, 2, 5, 10, std::numeric_limits<int>::max()};  // upper bounds
-  std::array<long, 5> searched{}, found{}, missed_near{}, missed_far{};
+  std::array<long, 5> searched{}, found{}, missed{}, missed_near{}, missed_far{};
   // Keyframe pixels are the working camera's: measured only where they are the renderer's.
   const bool same_pixels = working.width == camera.width && working.height == camera.height;
   if (same_pixels) {
@@ -282,6 +283,7 @@ int main(int argc, char** argv) {
       if (seen.z() <= 0) continue;
       const double error = (camera.Project(seen) - m.pixel).norm();
       if (!m.found) {
+        ++missed[age];
         missed_near[age] += error < kNearMiss;
         missed_far[age] += error > vo_options.search.max_search_radius;
       } else if (m.used) {
@@ -333,8 +335,6 @@ int main(int argc, char** argv) {
       for (size_t k = 0; k < count.size(); ++k) std::printf(" %5.1f%%", of[k] > 0 ? 100.0 * count[k] / of[k] : 0.0);
       std::printf("\n");
     };
-    std::array<long, 5> missed;
-    for (size_t k = 0; k < missed.size(); ++k) missed[k] = searched[k] - found[k];
     std::printf("  searches by age  frames since the feature's keyframe:  1      2    3-5   6-10    11+\n");
     row("found", found, searched);
     char near_name[32];

@@ -442,17 +442,18 @@ void Renderer::Render(const std::vector<Rigid3d>& exposure_poses, double time, u
   PDVO_THROW_CHECK(!exposure_poses.empty(), InvalidArgument, "render: no pose");
   const int w = camera_.width, h = camera_.height;
   cv::Mat colour(h, w, CV_32FC3, cv::Scalar::all(0));
-  RenderedFrame blur;
   if (fine_) {
     const Camera& f = fine_->camera_;
     cv::Mat fine_colour(f.height, f.width, CV_32FC3, cv::Scalar::all(0));
+    RenderedFrame fine_geometry;
     for (const Rigid3d& pose : exposure_poses) {
-      fine_->RenderGeometry(pose, &blur);
-      fine_->Shade(pose, blur, &fine_colour);
+      fine_->RenderGeometry(pose, &fine_geometry);
+      fine_->Shade(pose, fine_geometry, &fine_colour);
     }
     cv::resize(fine_colour, colour, colour.size(), 0, 0, cv::INTER_AREA);
     RenderGeometry(exposure_poses.back(), out);
   } else {
+    RenderedFrame blur;
     for (size_t k = 0; k + 1 < exposure_poses.size(); ++k) {
       RenderGeometry(exposure_poses[k], &blur);
       Shade(exposure_poses[k], blur, &colour);
