@@ -55,6 +55,11 @@ int main(int argc, char** argv) {
   int count = 20;
   pdvo::DetectorOptions options;
   for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::fprintf(stderr,
+                   "usage: detector_bench [--model=PATH] [--images=N] [option=value ...]   (DetectorOptions)\n");
+      return 0;
+    }
     if (std::strncmp(argv[i], "--model=", 8) == 0) {
       model = argv[i] + 8;
     } else if (std::strncmp(argv[i], "--images=", 9) == 0) {

@@ -15,6 +15,11 @@ using pdvo::ResidentMiB;
 
 int main(int argc, char** argv) {
   const int frames = argc > 1 ? std::atoi(argv[1]) : 2000;
+  const bool help = argc > 1 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help");
+  if (help || frames <= 0) {
+    std::fprintf(stderr, "usage: synth_bench [frames (default 2000)]\n");
+    return help ? 0 : 2;
+  }
   pdvo::sim::SynthOptions options;
   const pdvo::Camera camera = options.MakeCamera();
   const auto [street, walk] = pdvo::sim::MakeWalkedStreet(options, frames, 1);

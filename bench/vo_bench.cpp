@@ -53,6 +53,14 @@ int main(int argc, char** argv) {
   pdvo::KeepFreedMemory();  // as pdvo does
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1000;
   const uint64_t seed = argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 1;
+  const bool help = argc > 1 && (std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help");
+  if (help || frames <= 0) {
+    std::fprintf(stderr,
+                 "usage: vo_bench [frames (default 1000)] [seed (default 1)] [option=value ...]\n"
+                 "  options: those of pdvo vo (e.g. mode=idpp search.min_ncc=0.85); source=model|oracle and\n"
+                 "  model=PATH for mode=pdvo; synth=FILE for the street (e.g. synth=sim/config/driving.yaml)\n");
+    return help ? 0 : 2;
+  }
   pdvo::vo::VoOptions vo_options;
   std::string source = "model", model_path = std::string(PDVO_SOURCE_DIR) + "/models/default/model.yml";
   std::string synth_path;  // the street's options (section synth:), e.g. sim/config/driving.yaml

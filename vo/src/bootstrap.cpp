@@ -6,6 +6,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <utility>
 
 #include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
@@ -95,13 +96,16 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from,
     bearings_second.push_back(camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized());
   }
   const size_t n = motion->inliers.size();
-  if (n < kBootstrapInliers || 2 * n < to.size()) return false;
+  if (n < kBootstrapInliers) return false;
+  motion->found = true;
+  motion->first_from_second = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre);
+  if (2 * n < to.size()) return false;
   if (Median(parallax) < parallax_deg * M_PI / 180) return false;
   if (MedianUnexplainedByRotation(bearings_first, bearings_second) < kMinUnexplainedShare * parallax_deg * M_PI / 180)
     return false;
   const double scale = 1 / (inverse_depth * Median(distance));
   for (Eigen::Vector3d& x : motion->points) x *= scale;
-  motion->first_from_second = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre * scale);
+  motion->first_from_second.translation *= scale;
   return true;
 }
 
@@ -153,6 +157,7 @@ void TwoViewBootstrap::Stop() {
   active_ = false;
   tracks_.clear();
   previous_ = cv::Mat();
+  last_direction_.reset();
 }
 
 void TwoViewBootstrap::Begin(const cv::Mat& grey, double timestamp, size_t index, const CameraState& first) {
@@ -189,7 +194,12 @@ std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double
     return std::nullopt;
   }
   TwoViewMotion motion;
-  if (!EstimateTwoView(camera_, tracks_.front(), tracks_.back(), o_.parallax, inverse_depth_, &motion)) {
+  const bool enough = EstimateTwoView(camera_, tracks_.front(), tracks_.back(), o_.parallax, inverse_depth_, &motion);
+  // Its direction must agree with the motion found a frame before (kMaxDirectionChange).
+  const std::optional<Eigen::Vector3d> before = std::exchange(last_direction_, std::nullopt);
+  if (motion.found) last_direction_ = motion.first_from_second.translation.normalized();
+  if (!enough || !before ||
+      std::acos(std::clamp(before->dot(*last_direction_), -1.0, 1.0)) > kMaxDirectionChange * M_PI / 180) {
     return std::nullopt;
   }
   const Rigid3d& first_from_current = motion.first_from_second;

@@ -6,8 +6,10 @@
 // corners' depths as its features' priors, at the scale that puts their median distance at 1 / the prior inverse
 // depth; the poses of the frames in between are replaced by those that fit the triangulated corners (PnP).
 // Without enough parallax after `frames` frames (a camera that only turns) it gives up and the filter goes on.
-// Known weaknesses (docs): the frame-to-frame tracks drift, which adds parallax, so far corners come out too
-// near; nearly pure forward motion can give an essential matrix of sideways motion.
+// Nearly pure forward motion can give one frame an essential matrix of sideways motion and a turn, which shows
+// more parallax than the true one and so passes the test where the true one does not: the motion must also agree
+// with the one found a frame before (its direction within kMaxDirectionChange). Known weakness (docs): the
+// frame-to-frame tracks drift, which adds parallax, so far corners come out too near.
 //
 // Pixels are those of the working camera (undistorted); the first camera's frame is x right, y down, z forward.
 #pragma once
@@ -43,8 +45,13 @@ struct BootstrapOptions {
 inline constexpr int kBootstrapCorners = 200;
 inline constexpr size_t kBootstrapInliers = 30;
 
+// Degrees: how far the direction of motion the bootstrap finds may turn from the previous frame's.
+inline constexpr double kMaxDirectionChange = 10;
+
 // The relative motion of two views and the triangulated inliers, in the first view's frame.
 struct TwoViewMotion {
+  // An essential matrix with at least kBootstrapInliers inliers: first_from_second is set, even if refused.
+  bool found = false;
   Rigid3d first_from_second;
   std::vector<int> inliers;             // indices into the correspondences
   std::vector<Eigen::Vector3d> points;  // per inlier, first view's frame, in the scale of `inverse_depth`
@@ -54,7 +61,8 @@ struct TwoViewMotion {
 // triangulated inliers (in front of both views), scaled so that their median distance from the second view is
 // 1 / inverse_depth; false if fewer than kBootstrapInliers (or fewer than half) are inliers, if their median
 // parallax is under `parallax_deg`, or if a pure rotation would leave them under half of that (a turn in front of
-// a near wall is not a translation).
+// a near wall is not a translation). Refused for the share of inliers or for parallax, the motion is still `found`,
+// with a unit translation.
 bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first,
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
                      TwoViewMotion* motion);
@@ -98,11 +106,12 @@ class TwoViewBootstrap {
   int border_;
   double min_distance_, inverse_depth_;
   bool active_ = false;
-  double time_ = 0;                               // of the first frame
-  size_t index_ = 0;                              // of the first frame
-  CameraState first_;                             // the camera at the first frame
-  cv::Mat previous_;                              // the last frame
-  std::vector<std::vector<cv::Point2f>> tracks_;  // per frame since the first, the corners still tracked
+  double time_ = 0;                                // of the first frame
+  size_t index_ = 0;                               // of the first frame
+  CameraState first_;                              // the camera at the first frame
+  cv::Mat previous_;                               // the last frame
+  std::vector<std::vector<cv::Point2f>> tracks_;   // per frame since the first, the corners still tracked
+  std::optional<Eigen::Vector3d> last_direction_;  // of the motion found a frame before (unit, first frame)
 };
 
 }  // namespace pdvo::vo
