@@ -61,8 +61,8 @@ struct TwoViewMotion {
 // triangulated inliers (in front of both views), scaled so that their median distance from the second view is
 // 1 / inverse_depth; false if fewer than kBootstrapInliers (or fewer than half) are inliers, if their median
 // parallax is under `parallax_deg`, or if a pure rotation would leave them under half of that (a turn in front of
-// a near wall is not a translation). Refused for the share of inliers or for parallax, the motion is still `found`,
-// with a unit translation.
+// a near wall is not a translation). Refused for too few inliers in share or too little parallax, the motion is
+// still `found`, with a unit translation.
 bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first,
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
                      TwoViewMotion* motion);
