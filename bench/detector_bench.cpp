@@ -27,7 +27,7 @@ double Median(std::vector<double> v) {
 
 void Report(const char* what, const pdvo::Detector& detector, const std::vector<cv::Mat>& images) {
   if (images.empty()) return;
-  std::vector<double> describe, windows, pooling, segmentation, segments, total, count, planes;
+  std::vector<double> describe, windows, pooling, segmentation, segments, total, count, points, planes;
   for (const cv::Mat& image : images) {
     const pdvo::Detections d = detector.Detect(image);
     describe.push_back(d.times.describe);
@@ -37,14 +37,15 @@ void Report(const char* what, const pdvo::Detector& detector, const std::vector<
     segments.push_back(d.times.segments);
     total.push_back(d.times.total);
     count.push_back(static_cast<double>(d.windows.size()));
+    points.push_back(static_cast<double>(d.points.size()));
     planes.push_back(static_cast<double>(
         std::count_if(d.segments.begin(), d.segments.end(), [](const pdvo::DetectedSegment& s) { return s.planar; })));
   }
   std::printf(
-      "detector_bench: %zu %s images, medians (ms): describe %.1f, windows %.1f (%.0f windows), pooling "
+      "detector_bench: %zu %s images, medians (ms): describe %.1f (%.0f points), windows %.1f (%.0f windows), pooling "
       "%.1f, segmentation %.1f, segments %.1f; total %.1f (target <= 30), %.0f planes\n",
-      images.size(), what, Median(describe), Median(windows), Median(count), Median(pooling), Median(segmentation),
-      Median(segments), Median(total), Median(planes));
+      images.size(), what, Median(describe), Median(points), Median(windows), Median(count), Median(pooling),
+      Median(segmentation), Median(segments), Median(total), Median(planes));
 }
 
 }  // namespace

@@ -121,12 +121,16 @@ std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, doubl
   std::vector<Eigen::Vector3d> colour;  // and their median colours
   std::vector<float> channel[3];
   const cv::Rect box = cv::boundingRect(mask);  // the columns and rows outside it hold no pixel of the mask
+  cv::Mat lab_columns, mask_columns;            // transposed: a column is a row, read in memory order
+  cv::transpose(lab(box), lab_columns);
+  cv::transpose(mask(box), mask_columns);
   for (int x = box.x; x < box.x + box.width; ++x) {
     for (auto& c : channel) c.clear();
-    for (int y = box.y; y < box.y + box.height; ++y) {
-      if (!mask.at<uchar>(y, x)) continue;
-      const cv::Vec3f& v = lab.at<cv::Vec3f>(y, x);
-      for (int k = 0; k < 3; ++k) channel[k].push_back(v[k]);
+    const uchar* in = mask_columns.ptr<uchar>(x - box.x);
+    const cv::Vec3f* values = lab_columns.ptr<cv::Vec3f>(x - box.x);
+    for (int y = 0; y < box.height; ++y) {
+      if (!in[y]) continue;
+      for (int k = 0; k < 3; ++k) channel[k].push_back(values[y][k]);
     }
     if (static_cast<int>(channel[0].size()) < min_pixels) continue;
     Eigen::Vector3d median;
@@ -167,19 +171,38 @@ std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, doubl
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
                          double normal_scale_deg) {
   const size_t n = points.size();
-  std::vector<std::vector<int>> holding(n);  // per point, the windows that hold it
-  for (size_t k = 0; k < windows.size(); ++k) {
-    for (size_t i = 0; i < n; ++i) {
-      if (windows[k].box.contains(NearestPixel(points[i]))) holding[i].push_back(static_cast<int>(k));
+  // The windows' edges cut the image into rectangles whose pixels all lie in the same windows: a point's windows
+  // are found once per rectangle, and points held by the same windows (most share a cell) are pooled once.
+  std::vector<int> xs, ys;
+  for (const DetectedWindow& w : windows) {
+    xs.insert(xs.end(), {w.box.x, w.box.x + w.box.width});
+    ys.insert(ys.end(), {w.box.y, w.box.y + w.box.height});
+  }
+  for (std::vector<int>* cuts : {&xs, &ys}) {
+    std::sort(cuts->begin(), cuts->end());
+    cuts->erase(std::unique(cuts->begin(), cuts->end()), cuts->end());
+  }
+  std::map<std::pair<long, long>, std::vector<int>> rectangles;  // the windows holding each rectangle
+  std::vector<const std::vector<int>*> holding(n);
+  for (size_t i = 0; i < n; ++i) {
+    const cv::Point p = NearestPixel(points[i]);
+    const auto key = std::make_pair(std::upper_bound(xs.begin(), xs.end(), p.x) - xs.begin(),
+                                    std::upper_bound(ys.begin(), ys.end(), p.y) - ys.begin());
+    auto [at, fresh] = rectangles.try_emplace(key);
+    if (fresh) {
+      for (size_t k = 0; k < windows.size(); ++k) {
+        if (windows[k].box.contains(p)) at->second.push_back(static_cast<int>(k));
+      }
     }
+    holding[i] = &at->second;
   }
   PointPooling out{std::vector<double>(n, 0.5), std::vector<Eigen::Vector3d>(n, Eigen::Vector3d::Zero())};
-  std::map<std::vector<int>, size_t> pooled;  // points held by the same windows (most share a cell) pool alike
+  std::map<std::vector<int>, size_t> pooled;
   std::vector<double> probabilities;
   std::vector<Eigen::Vector3d> normals;
   for (size_t i = 0; i < n; ++i) {
-    if (holding[i].empty()) continue;
-    const auto [known, fresh] = pooled.emplace(holding[i], i);
+    if (holding[i]->empty()) continue;
+    const auto [known, fresh] = pooled.try_emplace(*holding[i], i);
     if (!fresh) {
       out.planarity[i] = out.planarity[known->second];
       out.normals[i] = out.normals[known->second];
@@ -187,7 +210,7 @@ PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vect
     }
     probabilities.clear();
     normals.clear();
-    for (const int k : holding[i]) {
+    for (const int k : *holding[i]) {
       probabilities.push_back(windows[static_cast<size_t>(k)].plane_probability);
       normals.push_back(windows[static_cast<size_t>(k)].normal);
     }
@@ -211,6 +234,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(column_split_penalty >= 0 && column_split_width >= 1);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
   PDVO_CHECK_OPTION(cell_radius > 0);
+  PDVO_CHECK_OPTION(point_quality > 0 && point_quality < 1 && point_min_distance >= 1);
   return true;
 }
 
@@ -238,7 +262,10 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
                                   << "the smallest window");
   std::optional<Camera> working_camera;
   if (camera) working_camera = camera->Rescaled(work.cols, work.rows);
-  const ImageWords words = recogniser_.Describe(work, working_camera);
+  FeatureOptions points = model.options.features;
+  points.quality = o.point_quality;
+  points.min_distance = o.point_min_distance;
+  const ImageWords words = recogniser_.Describe(work, working_camera, &points);
   d.points = words.points;
   d.times.describe = Ms(start);
 
@@ -356,15 +383,23 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   }
   std::vector<int> non_planar(n, -1);
   for (int i = 0; i < n; ++i) non_planar[i] = d.orientation[i] < 0 ? 0 : -1;
+  // The members' cells within cell_radius lie in their points' bounding box widened by it (by a quarter more: the
+  // distance transform's 5x5 mask approximates Euclidean distances to within a few percent).
+  const int reach = static_cast<int>(std::ceil(1.25 * o.cell_radius)) + 1;
   auto area_of = [&](const std::vector<int>& members) {
     std::vector<bool> in(n, false);
-    for (const int i : members) in[i] = true;
+    int x0 = work.cols, y0 = work.rows, x1 = -1, y1 = -1;
+    for (const int i : members) {
+      in[i] = true;
+      const cv::Point q = NearestPixel(d.points[i]);
+      x0 = std::min(x0, q.x), y0 = std::min(y0, q.y), x1 = std::max(x1, q.x), y1 = std::max(y1, q.y);
+    }
     cv::Mat mask(work.size(), CV_8U, cv::Scalar(0));
-    for (int y = 0; y < work.rows; ++y) {
+    for (int y = std::max(0, y0 - reach); y <= std::min(work.rows - 1, y1 + reach); ++y) {
       const int* label = labels.ptr<int>(y);
       const float* dist = distance.ptr<float>(y);
       uchar* out = mask.ptr<uchar>(y);
-      for (int x = 0; x < work.cols; ++x) {
+      for (int x = std::max(0, x0 - reach); x <= std::min(work.cols - 1, x1 + reach); ++x) {
         const int i = label[x] < static_cast<int>(point_of_label.size()) ? point_of_label[label[x]] : -1;
         if (i >= 0 && in[i] && dist[x] <= o.cell_radius) out[x] = 255;
       }

@@ -154,9 +154,11 @@ Recogniser::Recogniser(PlaneModel model) : model_(std::move(model)) {
   }
 }
 
-ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera>& camera) const {
+ImageWords Recogniser::Describe(const cv::Mat& image, const std::optional<Camera>& camera,
+                                const FeatureOptions* points) const {
   const RecogniserOptions& o = model_.options;
-  ImageWords words = QuantiseFeatures(ExtractFeatures(image, o.features), model_.gradient_words, model_.colour_words);
+  ImageWords words = QuantiseFeatures(ExtractFeatures(image, points ? *points : o.features), model_.gradient_words,
+                                      model_.colour_words);
   words.edges = FindEdgePlanes(image, camera, o.vanishing);
   return words;
 }

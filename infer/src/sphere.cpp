@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <tuple>
 
 #include "pdvo/common/errors.h"
 
@@ -56,16 +58,32 @@ std::vector<DirectionMode> MeanShiftModes(const std::vector<Eigen::Vector3d>& d,
   const double kappa = 1 / std::pow(bandwidth_deg * kDegree, 2);
   // The kernel is cut off beyond three bandwidths (where it is below 1.2% of its peak).
   const double cutoff = std::cos(std::min(M_PI, 3 * bandwidth_deg * kDegree));
+  // Equal directions are summed once, with their weights added (the detector's points share their cell's normal).
+  std::vector<Eigen::Vector3d> unique;
+  std::vector<double> unique_weight;
+  std::map<std::tuple<double, double, double>, size_t> index;
+  for (size_t i = 0; i < d.size(); ++i) {
+    const auto [at, fresh] = index.emplace(std::make_tuple(d[i].x(), d[i].y(), d[i].z()), unique.size());
+    if (fresh) {
+      unique.push_back(d[i]);
+      unique_weight.push_back(0);
+    }
+    unique_weight[at->second] += w[i];
+  }
   std::vector<Eigen::Vector3d> modes;
+  std::vector<size_t> started;  // a start equal to an earlier one ends where it did
   const size_t step = std::max<size_t>(1, (d.size() + max_starts - 1) / max_starts);
   for (size_t s = 0; s < d.size(); s += step) {
     if (w[s] <= 0) continue;
+    const size_t u = index.at(std::make_tuple(d[s].x(), d[s].y(), d[s].z()));
+    if (std::find(started.begin(), started.end(), u) != started.end()) continue;
+    started.push_back(u);
     Eigen::Vector3d m = d[s].normalized();
     for (int k = 0; k < kIterations; ++k) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (size_t i = 0; i < d.size(); ++i) {
-        const double c = m.dot(d[i]);
-        if (c > cutoff) sum += w[i] * std::exp(kappa * (c - 1)) * d[i];
+      for (size_t i = 0; i < unique.size(); ++i) {
+        const double c = m.dot(unique[i]);
+        if (c > cutoff) sum += unique_weight[i] * std::exp(kappa * (c - 1)) * unique[i];
       }
       if (sum.norm() < 1e-300) break;
       const Eigen::Vector3d next = sum.normalized();

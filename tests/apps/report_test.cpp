@@ -53,7 +53,7 @@ class Report : public ::testing::Test {
     dir_ = new test::TempDir();
     const test::TempDir& d = *dir_;
     const std::string model = PDVO_SOURCE_DIR "/models/default/model.yml";
-    ok_ = Shell(Pdvo("synth -o " + (d / "street") + " -n 120 --seed 3 -v warning", d)) == 0 &&
+    ok_ = Shell(Pdvo("synth -o " + (d / "street") + " -n 200 --seed 3 -v warning", d)) == 0 &&
           Shell(Pdvo(
               "vo -s " + (d / "street") + " -o " + (d / "pdvo") + " --mode pdvo -m " + model + " --overlay -v warning",
               d)) == 0 &&
@@ -138,6 +138,8 @@ TEST_F(Report, ShowsTheNumbersOfTheRuns) {
 }
 
 TEST_F(Report, TheThreeDViewDraws) {
+  // The view is of the pdvo run: it has planes to draw only if the run mapped some.
+  ASSERT_GT(Json("pdvo/stats.json")["totals"]["planes"].get<int>(), 0) << "the pdvo run mapped no plane";
   const cv::Mat shot = cv::imread((fs::current_path() / "report_map.png").string(), cv::IMREAD_COLOR);
   ASSERT_FALSE(shot.empty());
   // Inside the view, below its title and legend: pixels that are not the white background, and their colours.

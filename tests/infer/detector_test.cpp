@@ -1,16 +1,20 @@
-// The plane detector: pooling on hand-made windows; an end-to-end detection on a rendered street whose planes are
-// known (its largest planes found, with their orientation); the same image gives the same annotation bytes, from
-// one thread or two at once; images too small or empty are refused; the shipped options file equals the defaults.
+// The plane detector: pooling on hand-made windows and against the direct computation; an end-to-end detection on a
+// rendered street whose planes are known (its largest planes found, with their orientation); the same image gives the
+// same annotation bytes, from one thread or two at once; images too small or empty are refused; the shipped options
+// file equals the defaults.
 #include "pdvo/infer/detector.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
+#include <random>
 #include <thread>
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/common/options.h"
+#include "pdvo/infer/sphere.h"
 #include "pdvo/sim/renderer.h"
 #include "pdvo/sim/synth.h"
 
@@ -31,6 +35,43 @@ TEST(Detector, PoolsTheWindowsThatHoldAPoint) {
   EXPECT_DOUBLE_EQ(p.planarity[2], 0.5);       // no window: undecided
   EXPECT_LT((p.normals[0] - a).norm(), 0.05);  // the light, far normal b hardly moves the robust mean
   EXPECT_EQ(p.normals[2], Eigen::Vector3d::Zero());
+}
+
+// Windows anywhere (not on a grid), points anywhere: each point pools exactly the windows that hold its pixel, as a
+// direct pooling of those windows gives.
+TEST(Detector, PoolingEqualsTheDirectComputation) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> at(0, 150), side(5, 80);
+  std::uniform_real_distribution<double> u(-1, 1), p(0, 1);
+  std::vector<DetectedWindow> windows;
+  for (int k = 0; k < 40; ++k) {
+    windows.push_back(
+        {cv::Rect(at(rng), at(rng), side(rng), side(rng)), p(rng), Eigen::Vector3d(u(rng), u(rng), -1).normalized()});
+  }
+  std::vector<cv::Point2f> points;
+  for (int i = 0; i < 300; ++i) points.emplace_back(0.5f * at(rng) + 0.5f * at(rng), 0.5f * at(rng) + 0.5f * at(rng));
+  const PointPooling pooled = PoolWindows(points, windows, 15);
+  int held = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    std::vector<double> probabilities;
+    std::vector<Eigen::Vector3d> normals;
+    for (const DetectedWindow& w : windows) {
+      if (!w.box.contains(NearestPixel(points[i]))) continue;
+      probabilities.push_back(w.plane_probability);
+      normals.push_back(w.normal);
+    }
+    if (probabilities.empty()) {
+      EXPECT_EQ(pooled.planarity[i], 0.5) << i;
+      continue;
+    }
+    ++held;
+    std::vector<double> sorted = probabilities;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t m = sorted.size();
+    EXPECT_DOUBLE_EQ(pooled.planarity[i], m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2])) << i;
+    EXPECT_EQ(pooled.normals[i], RobustMeanDirection(normals, probabilities, 15)) << i;
+  }
+  EXPECT_GT(held, 200);  // most points lie in some window
 }
 
 // Columns of two colours, each with a window pattern of a third colour in a minority of every column: one cut, at

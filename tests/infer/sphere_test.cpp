@@ -1,6 +1,6 @@
 // Directions on the sphere: mean shift recovers known clusters of normals (three planes' orientations with
-// noise and scattered outliers), ordered by their weight; the robust mean ignores outliers that pull the plain
-// mean away.
+// noise and scattered outliers), ordered by their weight, and gives the same from repeated directions as from
+// their weighted set; the robust mean ignores outliers that pull the plain mean away.
 #include "pdvo/infer/sphere.h"
 
 #include <gtest/gtest.h>
@@ -47,6 +47,33 @@ TEST(Sphere, MeanShiftRecoversKnownClusters) {
   EXPECT_NEAR(modes[0].support, 60, 1);
   EXPECT_NEAR(modes[1].support, 40, 1);
   for (size_t k = 3; k < modes.size(); ++k) EXPECT_LT(modes[k].support, 1) << k;  // only the outliers
+}
+
+// The detector's points share their cell's normal: repeated directions are summed once with their weights added,
+// which must give the modes and supports of the directions given once with those weights.
+TEST(Sphere, MeanShiftOfRepeatedDirectionsEqualsTheirWeightedSet) {
+  std::mt19937 rng(7);
+  std::vector<Eigen::Vector3d> once, repeated;
+  std::vector<double> weight_once, weight_repeated;
+  Scatter(Eigen::Vector3d(0, -1, 0), 12, 5, 1.0, rng, &once, &weight_once);
+  Scatter(Eigen::Vector3d(1, 0, -0.3), 8, 5, 1.0, rng, &once, &weight_once);
+  std::uniform_int_distribution<int> copies(1, 4);
+  for (size_t i = 0; i < once.size(); ++i) {
+    const int c = copies(rng);
+    weight_once[i] = 0.5 * c;
+    for (int k = 0; k < c; ++k) {
+      repeated.push_back(once[i]);
+      weight_repeated.push_back(0.5);
+    }
+  }
+  // Starts from every direction in both cases.
+  const std::vector<DirectionMode> a = MeanShiftModes(once, weight_once, 10, 5, 1000);
+  const std::vector<DirectionMode> b = MeanShiftModes(repeated, weight_repeated, 10, 5, 1000);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_LT(AngleDeg(a[k].direction, b[k].direction), 1e-6) << k;
+    EXPECT_NEAR(a[k].support, b[k].support, 1e-9) << k;
+  }
 }
 
 TEST(Sphere, RobustMeanIgnoresOutliers) {

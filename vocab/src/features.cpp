@@ -91,6 +91,7 @@ bool FeatureOptions::Check() const {
   PDVO_CHECK_OPTION(detector == "fast" || detector == "gftt" || detector == "dense");
   PDVO_CHECK_OPTION(max_points >= 1);
   PDVO_CHECK_OPTION(patch_size >= 4 && patch_size % 2 == 0);
+  PDVO_CHECK_OPTION(quality > 0 && quality < 1 && min_distance >= 1);
   PDVO_CHECK_OPTION(fast_threshold >= 1 && grid_step >= 1);
   return true;
 }
@@ -107,7 +108,7 @@ Features ExtractFeatures(const cv::Mat& image, const FeatureOptions& o, const cv
     cv::FAST(grey, candidates, o.fast_threshold, true);
   } else if (o.detector == "gftt") {
     std::vector<cv::Point2f> corners;
-    cv::goodFeaturesToTrack(grey, corners, o.max_points * 2, 0.01, o.patch_size / 4.0);
+    cv::goodFeaturesToTrack(grey, corners, o.max_points * 2, o.quality, o.min_distance);
     for (const auto& c : corners) candidates.emplace_back(c, static_cast<float>(o.patch_size), -1, 1.0f);
   } else {
     for (int y = o.patch_size / 2; y < grey.rows - o.patch_size / 2; y += o.grid_step) {

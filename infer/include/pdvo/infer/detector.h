@@ -50,6 +50,11 @@ struct DetectorOptions {
   int column_split_width = 12;         // px: the narrowest part
   double min_plane_probability = 0.5;  // a plane segment recognised again below this is dropped
   double cell_radius = 16;             // px: a segment's area is its points' Voronoi cells within this distance
+  // The image is described with salient points of its own, in place of the model's (FeatureOptions' quality and
+  // min_distance; the shipped model's are 0.01 and 4 px): weaker corners, farther apart, cover the smooth parts
+  // of planes that the model's points leave empty, with fewer points in all (docs/detector.md).
+  double point_quality = 0.001;
+  double point_min_distance = 8;  // px
   // The stages, for measuring what each adds. Off: a point is planar if its planarity exceeds 0.5 (MRF 1); takes
   // its nearest orientation (MRF 2); a segment's normal is its points' robust mean and its score their mean
   // planarity, and it is kept (re-recognition).
@@ -78,6 +83,8 @@ struct DetectorOptions {
     visit("column_split_width", self.column_split_width);
     visit("min_plane_probability", self.min_plane_probability);
     visit("cell_radius", self.cell_radius);
+    visit("point_quality", self.point_quality);
+    visit("point_min_distance", self.point_min_distance);
     visit("mrf_planes", self.mrf_planes);
     visit("mrf_orientations", self.mrf_orientations);
     visit("rerecognise", self.rerecognise);

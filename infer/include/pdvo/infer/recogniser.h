@@ -93,8 +93,10 @@ class Recogniser {
   const PlaneModel& model() const { return model_; }
 
   // Points, words and edges of an image already at the working size (see ToWorkingSize). Without `camera`,
-  // Camera::WithFieldOfView with the options' field of view (see VanishingOptions).
-  ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt) const;
+  // Camera::WithFieldOfView with the options' field of view (see VanishingOptions). The salient points are the
+  // model's (its options' features) unless `points` gives others.
+  ImageWords Describe(const cv::Mat& image, const std::optional<Camera>& camera = std::nullopt,
+                      const FeatureOptions* points = nullptr) const;
   RegionPrediction Recognise(const ImageWords& words, const Region& region) const;
   // The same from a region's (not standardised) feature vector, without the fusion with the region's edges
   // (FuseNormal in vanishing.h) and without turning the normal to face the camera, which need the image. The

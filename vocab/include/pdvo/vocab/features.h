@@ -15,6 +15,8 @@ struct FeatureOptions {
   std::string detector = "gftt";
   int max_points = 1500;    // per image, strongest first
   int patch_size = 16;      // px, the patch described around each point
+  double quality = 0.01;    // gftt: corners whose score is at least this share of the image's strongest
+  double min_distance = 4;  // px, gftt: the least distance between two points
   int fast_threshold = 15;  // FAST intensity threshold
   int grid_step = 8;        // px, dense detector spacing
 
@@ -23,6 +25,8 @@ struct FeatureOptions {
     visit("detector", self.detector);
     visit("max_points", self.max_points);
     visit("patch_size", self.patch_size);
+    visit("quality", self.quality);
+    visit("min_distance", self.min_distance);
     visit("fast_threshold", self.fast_threshold);
     visit("grid_step", self.grid_step);
   }
