@@ -139,17 +139,26 @@ Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, con
   return {count / area, strength > 0 ? vertical / strength : 0.0};
 }
 
-double AzimuthLikelihood::MeanLogLikelihood(double phi) const {
+double AzimuthLikelihood::MeanLogLikelihood(double phi) const { return MeanLogLikelihoods({phi}).front(); }
+
+std::vector<double> AzimuthLikelihood::MeanLogLikelihoods(const std::vector<double>& phis) const {
   PDVO_THROW_CHECK(!empty(), InvalidArgument, "azimuth likelihood: no edges");
-  const float c = static_cast<float>(std::cos(phi) / residual_scale);
-  const float s = static_cast<float>(std::sin(phi) / residual_scale);
-  double sum = 0, mass = 0;
-  for (size_t i = 0; i < constraints.size(); ++i) {
-    const float r = constraints[i].x() * c + constraints[i].y() * s;
-    sum -= weights[i] * std::log1p(r * r);
-    mass += weights[i];
+  // All the residuals in one matrix product and their logarithms several at a time (most of FuseNormal's time).
+  const Eigen::Index n = static_cast<Eigen::Index>(constraints.size()), k = static_cast<Eigen::Index>(phis.size());
+  const Eigen::Map<const Eigen::Matrix<float, 2, Eigen::Dynamic>> m(constraints.front().data(), 2, n);
+  const Eigen::Map<const Eigen::VectorXf> w(weights.data(), n);
+  Eigen::Matrix<float, 2, Eigen::Dynamic> d(2, k);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    d(0, j) = static_cast<float>(std::cos(phis[static_cast<size_t>(j)]) / residual_scale);
+    d(1, j) = static_cast<float>(std::sin(phis[static_cast<size_t>(j)]) / residual_scale);
   }
-  return sum / mass;
+  const Eigen::ArrayXXf r = (m.transpose() * d).array();  // n x k
+  const Eigen::ArrayXXf logs = (r * r).log1p();
+  const Eigen::VectorXd sums = logs.matrix().cast<double>().transpose() * w.cast<double>();
+  const double mass = w.cast<double>().sum();
+  std::vector<double> out(static_cast<size_t>(k));
+  for (Eigen::Index j = 0; j < k; ++j) out[static_cast<size_t>(j)] = -sums[j] / mass;
+  return out;
 }
 
 Eigen::Vector3d AzimuthLikelihood::Normal(double phi, const Eigen::Vector3d& towards) const {
@@ -225,18 +234,22 @@ Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes
   const AzimuthLikelihood l = RegionAzimuthLikelihood(edges, region, o);
   if (l.empty()) return NearestFacing(model_normal, ray);
   const double prior_phi = l.Phi(model_normal);
-  auto posterior = [&](double phi) {
-    return o.prior_weight * std::cos(2 * (phi - prior_phi)) + l.MeanLogLikelihood(phi);
-  };
   double best_phi = 0, best = -1e300;
-  auto consider = [&](double phi) {
-    const double p = posterior(phi);
-    if (p > best) best = p, best_phi = phi;
+  auto consider = [&](const std::vector<double>& phis) {  // the posterior's largest over phis, if larger
+    const std::vector<double> likelihoods = l.MeanLogLikelihoods(phis);
+    for (size_t i = 0; i < phis.size(); ++i) {
+      const double p = o.prior_weight * std::cos(2 * (phis[i] - prior_phi)) + likelihoods[i];
+      if (p > best) best = p, best_phi = phis[i];
+    }
   };
   const double coarse = M_PI / kCoarseSteps;
-  for (int i = 0; i < kCoarseSteps; ++i) consider((i + 0.5) * coarse);
+  std::vector<double> phis;
+  for (int i = 0; i < kCoarseSteps; ++i) phis.push_back((i + 0.5) * coarse);
+  consider(phis);
   const double centre = best_phi;
-  for (double step = -coarse / 2; step <= coarse / 2 + 1e-9; step += kDegree) consider(centre + step);
+  phis.clear();
+  for (double step = -coarse / 2; step <= coarse / 2 + 1e-9; step += kDegree) phis.push_back(centre + step);
+  consider(phis);
   return l.Normal(best_phi, -ray);
 }
 

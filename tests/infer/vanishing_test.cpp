@@ -146,13 +146,18 @@ TEST(Vanishing, LikelihoodIsTheMeanCauchyLogLikelihood) {
   l.residual_scale = 0.5;
   l.constraints = {{0.3f, -0.2f}, {0.0f, 0.8f}, {-0.5f, 0.1f}};
   l.weights = {1.0f, 2.0f, 0.5f};
-  const double phi = 0.7;
-  double sum = 0;
-  for (size_t i = 0; i < 3; ++i) {
-    const double r = (l.constraints[i].x() * std::cos(phi) + l.constraints[i].y() * std::sin(phi)) / 0.5;
-    sum -= l.weights[i] * std::log(1 + r * r);
+  const std::vector<double> phis = {0.0, 0.7, 1.5, 2.9};
+  const std::vector<double> batch = l.MeanLogLikelihoods(phis);
+  ASSERT_EQ(batch.size(), phis.size());
+  for (size_t k = 0; k < phis.size(); ++k) {
+    double sum = 0;
+    for (size_t i = 0; i < 3; ++i) {
+      const double r = (l.constraints[i].x() * std::cos(phis[k]) + l.constraints[i].y() * std::sin(phis[k])) / 0.5;
+      sum -= l.weights[i] * std::log(1 + r * r);
+    }
+    EXPECT_NEAR(l.MeanLogLikelihood(phis[k]), sum / 3.5, 1e-6) << phis[k];
+    EXPECT_NEAR(batch[k], sum / 3.5, 1e-6) << phis[k];
   }
-  EXPECT_NEAR(l.MeanLogLikelihood(phi), sum / 3.5, 1e-6);
   // Normal and Phi are inverse: the normal is horizontal, on the side asked for, and d(phi) lies in its plane.
   for (const double p : {0.1, 1.0, 2.0, 3.0}) {
     const Eigen::Vector3d towards(0.2, 0, -1), n = l.Normal(p, towards);
