@@ -4,11 +4,13 @@
 # the real sets of ../shared/data with reference annotations (Strecha, KITTI, TUM). One line per set: plane pixel
 # F1, false plane area, non-plane F1, plane recall within 30 / 10 degrees, median normal error of matched
 # planes, spurious planes per image, covering, ms per image.
-# Usage: bench/detection_eval.sh WORK [--set key=value ...]   (detector options, e.g. --set mrf_planes=false)
+# With --validation, only the validation streets instead (seeds 601-603 ahead, 604-606 around, scored as one set:
+# where detector options are chosen, apart from the held-out ones).
+# Usage: bench/detection_eval.sh WORK [--validation] [--set key=value ...]   (detector options, e.g. --set mrf_planes=false)
 # e.g. bench/detection_eval.sh out/detection_eval
 set -euo pipefail
 if [ $# -lt 1 ]; then
-  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,7p'
+  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,10p'
   exit 2
 fi
 work=$1
@@ -27,8 +29,11 @@ render() {  # LOOK_DEG SEED...
     "$pdvo" synth -o "$work/streets/street_$s" -n 15 --seed "$s" --set walk.fps=1 --set walk.look_deg="$look" -v warning
   done
 }
-render 0 $(seq 501 508)
-render 60 $(seq 511 518)
+validation=false
+if [ "${1:-}" = --validation ]; then
+  validation=true
+  shift
+fi
 # Every reference folder of a set is detected; the set is scored over all its folders at once.
 score() {  # NAME FOLDER...
   local name=$1 folder k=0
@@ -59,6 +64,14 @@ score() {  # NAME FOLDER...
   rm -rf "$run"/* 
 }
 options=("$@")
+if $validation; then
+  render 0 601 602 603
+  render 60 604 605 606
+  score "validation streets" "$work"/streets/street_60[1-6]/annotations
+  exit 0
+fi
+render 0 $(seq 501 508)
+render 60 $(seq 511 518)
 streets_ahead=() streets_around=()
 for s in $(seq 501 508); do streets_ahead+=("$work/streets/street_$s/annotations"); done
 for s in $(seq 511 518); do streets_around+=("$work/streets/street_$s/annotations"); done
