@@ -139,8 +139,6 @@ Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, con
   return {count / area, strength > 0 ? vertical / strength : 0.0};
 }
 
-double AzimuthLikelihood::MeanLogLikelihood(double phi) const { return MeanLogLikelihoods({phi}).front(); }
-
 std::vector<double> AzimuthLikelihood::MeanLogLikelihoods(const std::vector<double>& phis) const {
   PDVO_THROW_CHECK(!empty(), InvalidArgument, "azimuth likelihood: no edges");
   // All the residuals in one matrix product and their logarithms several at a time (most of FuseNormal's time).

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/infer/vanishing.h"
@@ -82,14 +84,17 @@ Scene DrawScene(double azimuth_deg, double pitch_deg, double roll_deg, Lines lin
   return s;
 }
 
-// The phi maximising the likelihood alone, on a 0.1-degree grid.
+// A 0.1-degree grid of phi over [0, pi).
+std::vector<double> FineGrid() {
+  std::vector<double> phis;
+  for (int i = 0; i < 1800; ++i) phis.push_back((i + 0.5) * 0.1 * kDegree);
+  return phis;
+}
+
+// The phi maximising the likelihood alone, on that grid.
 double BestPhi(const AzimuthLikelihood& l) {
-  double best_phi = 0, best = -1e300;
-  for (int i = 0; i < 1800; ++i) {
-    const double phi = (i + 0.5) * 0.1 * kDegree, v = l.MeanLogLikelihood(phi);
-    if (v > best) best = v, best_phi = phi;
-  }
-  return best_phi;
+  const std::vector<double> phis = FineGrid(), v = l.MeanLogLikelihoods(phis);
+  return phis[std::max_element(v.begin(), v.end()) - v.begin()];
 }
 
 TEST(Vanishing, FindsTheVerticalOfATiltedCamera) {
@@ -155,7 +160,7 @@ TEST(Vanishing, LikelihoodIsTheMeanCauchyLogLikelihood) {
       const double r = (l.constraints[i].x() * std::cos(phis[k]) + l.constraints[i].y() * std::sin(phis[k])) / 0.5;
       sum -= l.weights[i] * std::log(1 + r * r);
     }
-    EXPECT_NEAR(l.MeanLogLikelihood(phis[k]), sum / 3.5, 1e-6) << phis[k];
+    EXPECT_NEAR(l.MeanLogLikelihoods({phis[k]}).front(), sum / 3.5, 1e-6) << phis[k];
     EXPECT_NEAR(batch[k], sum / 3.5, 1e-6) << phis[k];
   }
   // Normal and Phi are inverse: the normal is horizontal, on the side asked for, and d(phi) lies in its plane.
@@ -167,7 +172,7 @@ TEST(Vanishing, LikelihoodIsTheMeanCauchyLogLikelihood) {
     EXPECT_NEAR(l.Phi(n), p, 1e-9);
   }
   AzimuthLikelihood empty;
-  EXPECT_THROW(empty.MeanLogLikelihood(0), InvalidArgument);
+  EXPECT_THROW(empty.MeanLogLikelihoods({0.0}), InvalidArgument);
 }
 
 TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
@@ -183,11 +188,11 @@ TEST(Vanishing, FusionMovesTheModelsAzimuthToTheEdges) {
   // The maximum of the posterior, against a brute-force search on a 0.1-degree grid.
   const AzimuthLikelihood l = RegionAzimuthLikelihood(e, s.region, o);
   const double prior_phi = l.Phi(model);
+  const std::vector<double> phis = FineGrid(), likelihoods = l.MeanLogLikelihoods(phis);
   double best_phi = 0, best = -1e300;
-  for (int i = 0; i < 1800; ++i) {
-    const double phi = (i + 0.5) * 0.1 * kDegree;
-    const double p = o.prior_weight * std::cos(2 * (phi - prior_phi)) + l.MeanLogLikelihood(phi);
-    if (p > best) best = p, best_phi = phi;
+  for (size_t i = 0; i < phis.size(); ++i) {
+    const double p = o.prior_weight * std::cos(2 * (phis[i] - prior_phi)) + likelihoods[i];
+    if (p > best) best = p, best_phi = phis[i];
   }
   const Eigen::Vector3d ray = RegionRay(kCamera, s.region);
   EXPECT_LT(AngleDeg(fused, l.Normal(best_phi, -ray)), 0.6);

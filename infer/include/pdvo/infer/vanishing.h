@@ -82,9 +82,8 @@ struct AzimuthLikelihood {
   std::vector<float> weights;
   double residual_scale = 1;
   bool empty() const { return constraints.empty(); }
-  // The weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)): at most 0.
-  double MeanLogLikelihood(double phi) const;
-  std::vector<double> MeanLogLikelihoods(const std::vector<double>& phis) const;  // the same for each phi
+  // For each phi, the weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)): at most 0.
+  std::vector<double> MeanLogLikelihoods(const std::vector<double>& phis) const;
   // The unit normal of the vertical plane whose horizontal lines run along d(phi), on the side of `towards`.
   Eigen::Vector3d Normal(double phi, const Eigen::Vector3d& towards) const;
   // The phi of the vertical plane nearest to the plane with normal n (n not along the vertical).
