@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 
@@ -113,6 +117,76 @@ TEST(SearchPatch, FindsKnownShifts) {
   cv::RNG rng(99);
   rng.fill(other, cv::RNG::UNIFORM, 0, 256);
   EXPECT_FALSE(SearchPatch(other, patch, centre, s, options, &found));
+}
+
+// SearchPatch scores by direct sums inside the ellipse only; a brute-force reference scores the whole window with
+// OpenCV's matchTemplate (TM_CCOEFF_NORMED) and keeps the best inside the ellipse, with the same sub-pixel step.
+// On random patches, predictions and elongated ellipses (near the border too), both find the same match, to float
+// rounding, or both none.
+TEST(SearchPatch, EqualsAnExhaustiveMatchTemplateSearch) {
+  const cv::Mat image = Texture();
+  SearchOptions options;
+  options.min_ncc = 0.5;  // more matches to compare
+  const int half = options.patch_half;
+  auto reference = [&](const cv::Mat& patch, const Eigen::Vector2d& predicted, const Eigen::Matrix2d& s,
+                       Eigen::Vector2d* found) {
+    const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(s).eigenvalues().maxCoeff();
+    const int radius =
+        std::min(static_cast<int>(std::ceil(options.search_sigmas * std::sqrt(largest))), options.max_search_radius);
+    const cv::Point c(cvRound(predicted.x()), cvRound(predicted.y()));
+    const cv::Rect window =
+        cv::Rect(c.x - radius - half, c.y - radius - half, 2 * (radius + half) + 1, 2 * (radius + half) + 1) &
+        cv::Rect(0, 0, image.cols, image.rows);
+    cv::Mat region, score;
+    image(window).convertTo(region, CV_32F);
+    cv::matchTemplate(region, patch, score, cv::TM_CCOEFF_NORMED);
+    double best = -2;
+    cv::Point at;
+    for (int y = 0; y < score.rows; ++y) {
+      for (int x = 0; x < score.cols; ++x) {
+        const Eigen::Vector2d d(window.x + x + half - predicted.x(), window.y + y + half - predicted.y());
+        if (d.dot(s.inverse() * d) > options.search_sigmas * options.search_sigmas || score.at<float>(y, x) <= best)
+          continue;
+        best = score.at<float>(y, x);
+        at = cv::Point(x, y);
+      }
+    }
+    if (best < options.min_ncc) return false;
+    auto offset = [](double l, double c, double r) {
+      const double curvature = l - 2 * c + r;
+      return curvature < 0 ? std::clamp(0.5 * (l - r) / curvature, -0.5, 0.5) : 0.0;
+    };
+    const double dx = at.x > 0 && at.x + 1 < score.cols
+                          ? offset(score.at<float>(at.y, at.x - 1), best, score.at<float>(at.y, at.x + 1))
+                          : 0;
+    const double dy = at.y > 0 && at.y + 1 < score.rows
+                          ? offset(score.at<float>(at.y - 1, at.x), best, score.at<float>(at.y + 1, at.x))
+                          : 0;
+    *found = Eigen::Vector2d(window.x + at.x + half + dx, window.y + at.y + half + dy);
+    return true;
+  };
+  cv::RNG rng(3);
+  int compared = 0, matched = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Eigen::Vector2d source(rng.uniform(8.0, 312.0), rng.uniform(8.0, 232.0));
+    cv::Mat patch;
+    if (!WarpPatch(image, Eigen::Matrix3d::Identity(), source, half, &patch)) continue;
+    const Eigen::Vector2d predicted = source + Eigen::Vector2d(rng.uniform(-6.0, 6.0), rng.uniform(-6.0, 6.0));
+    const double angle = rng.uniform(0.0, M_PI), major = rng.uniform(0.5, 6.0), minor = rng.uniform(0.3, 2.0);
+    const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    const Eigen::Matrix2d s = r * Eigen::Vector2d(major * major, minor * minor).asDiagonal() * r.transpose();
+    Eigen::Vector2d direct, brute;
+    const bool a = SearchPatch(image, patch, predicted, s, options, &direct);
+    const bool b = reference(patch, predicted, s, &brute);
+    ASSERT_EQ(a, b) << "trial " << trial;
+    ++compared;
+    if (!a) continue;
+    ++matched;
+    EXPECT_LT((direct - brute).norm(), 1e-3) << "trial " << trial;
+  }
+  EXPECT_GT(compared, 250);
+  EXPECT_GT(matched, 100);
+  RecordProperty("matches_compared", std::to_string(matched));
 }
 
 // However uncertain the prediction (a huge, infinite or NaN covariance), the window is at most

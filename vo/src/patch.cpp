@@ -4,7 +4,8 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
+#include <vector>
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/options.h"
@@ -63,33 +64,128 @@ double Ncc(const cv::Mat& a, const cv::Mat& b) {
 
 namespace pdvo::vo {
 
+namespace {
+
+// The zero-mean NCC of a patch with the image patches of a window, by direct sums. The patch is made zero-mean
+// once (its correlation with an image patch is then that of both made zero-mean); summed-area tables of the
+// window's values and squares give each image patch's mean and variance in O(1). Positions (x, y) are the image
+// patches' top-left corners in the window.
+class WindowCorrelation {
+ public:
+  WindowCorrelation(const cv::Mat& image, const cv::Rect& window, const cv::Mat& patch)
+      : side_(patch.rows),
+        width_(window.width),
+        stride_(window.width + 1),
+        rows_(window.height - side_ + 1),
+        cols_(window.width - side_ + 1),
+        patch_(patch.begin<float>(), patch.end<float>()),
+        values_(static_cast<size_t>(window.width) * window.height),
+        sum_(static_cast<size_t>(stride_) * (window.height + 1), 0.0),
+        square_(sum_) {
+    const int n = side_ * side_;
+    double mean = 0;
+    for (float v : patch_) mean += v;
+    mean /= n;
+    for (float& v : patch_) {
+      v = static_cast<float>(v - mean);
+      patch_norm2_ += static_cast<double>(v) * v;
+    }
+    for (int y = 0; y < window.height; ++y) {
+      const uchar* row = image.ptr<uchar>(window.y + y) + window.x;
+      double line = 0, line_square = 0;
+      for (int x = 0; x < window.width; ++x) {
+        values_[y * width_ + x] = row[x];
+        line += row[x];
+        line_square += static_cast<double>(row[x]) * row[x];
+        sum_[(y + 1) * stride_ + x + 1] = sum_[y * stride_ + x + 1] + line;
+        square_[(y + 1) * stride_ + x + 1] = square_[y * stride_ + x + 1] + line_square;
+      }
+    }
+  }
+  int rows() const { return rows_; }
+  int cols() const { return cols_; }
+  bool flat_patch() const { return !(patch_norm2_ > 1e-9); }
+
+  double At(int x, int y) const {
+    float dot = 0;
+    for (int r = 0; r < side_; ++r) {
+      const float* row = values_.data() + (y + r) * width_ + x;
+      for (int c = 0; c < side_; ++c) dot += row[c] * patch_[r * side_ + c];
+    }
+    return Normalised(dot, x, y);
+  }
+  // The NCCs at positions first .. last - 1 of row y, as At gives them (the same sums in the same order), into
+  // out[first .. last - 1]: summed for the whole run at once, which vectorises.
+  void Row(int y, int first, int last, std::vector<float>* dots, std::vector<double>* out) const {
+    std::fill(dots->begin() + first, dots->begin() + last, 0.0f);
+    for (int r = 0; r < side_; ++r) {
+      const float* row = values_.data() + (y + r) * width_;
+      for (int c = 0; c < side_; ++c) {
+        const float q = patch_[r * side_ + c];
+        for (int x = first; x < last; ++x) (*dots)[x] += row[x + c] * q;
+      }
+    }
+    for (int x = first; x < last; ++x) (*out)[x] = Normalised((*dots)[x], x, y);
+  }
+
+ private:
+  double Normalised(float dot, int x, int y) const {
+    auto box = [&](const std::vector<double>& t) {
+      return t[(y + side_) * stride_ + x + side_] - t[y * stride_ + x + side_] - t[(y + side_) * stride_ + x] +
+             t[y * stride_ + x];
+    };
+    const double s = box(sum_), variance = box(square_) - s * s / (side_ * side_);
+    return variance > 1e-9 ? dot / std::sqrt(variance * patch_norm2_) : 0.0;  // a flat image patch: 0
+  }
+
+  int side_, width_, stride_, rows_, cols_;
+  std::vector<float> patch_;   // zero-mean
+  double patch_norm2_ = 0;     // its squared norm
+  std::vector<float> values_;  // the window
+  std::vector<double> sum_, square_;
+};
+
+}  // namespace
+
 bool SearchPatch(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector2d& predicted,
                  const Eigen::Matrix2d& innovation, const SearchOptions& o, Eigen::Vector2d* found) {
+  const int half = o.patch_half, side = 2 * half + 1;
+  PDVO_THROW_CHECK(image.type() == CV_8UC1 && patch.type() == CV_32FC1 && patch.rows == side && patch.cols == side,
+                   InvalidArgument,
+                   "SearchPatch: expected an 8-bit grey image and a " << side << "x" << side << " CV_32F patch");
   const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(innovation).eigenvalues().maxCoeff();
   // Bounded before the conversion: a huge (or NaN) covariance gives the largest window, not an overflow.
   const double wanted_radius = std::ceil(o.search_sigmas * std::sqrt(largest));
   const int radius = wanted_radius < o.max_search_radius ? static_cast<int>(wanted_radius) : o.max_search_radius;
-  const int half = o.patch_half;
   if (!(std::abs(predicted.x()) < 1e6 && std::abs(predicted.y()) < 1e6)) return false;
   const cv::Point centre(cvRound(predicted.x()), cvRound(predicted.y()));
   const cv::Rect wanted(centre.x - radius - half, centre.y - radius - half, 2 * (radius + half) + 1,
                         2 * (radius + half) + 1);
   const cv::Rect window = wanted & cv::Rect(0, 0, image.cols, image.rows);
-  if (window.width < patch.cols || window.height < patch.rows) return false;
-  cv::Mat region, score;
-  image(window).convertTo(region, CV_32F);
-  cv::matchTemplate(region, patch, score, cv::TM_CCOEFF_NORMED);
+  if (window.width < side || window.height < side) return false;
+  const WindowCorrelation ncc(image, window, patch);
+  if (ncc.flat_patch()) return false;
+  // Scored only where the innovation ellipse reaches (the window is its bounding square): per row of positions,
+  // the run of columns inside it (an ellipse is convex).
   const Eigen::Matrix2d information = innovation.inverse();
   const double gate = o.search_sigmas * o.search_sigmas;
+  auto inside = [&](int x, int y) {
+    const Eigen::Vector2d d(window.x + x + half - predicted.x(), window.y + y + half - predicted.y());
+    return !(d.dot(information * d) > gate);  // a NaN covariance: the whole window
+  };
   double best = -2;
   cv::Point at(-1, -1);
-  for (int y = 0; y < score.rows; ++y) {
-    for (int x = 0; x < score.cols; ++x) {
-      const float v = score.at<float>(y, x);
-      if (!std::isfinite(v) || v <= best) continue;
-      const Eigen::Vector2d d(window.x + x + half - predicted.x(), window.y + y + half - predicted.y());
-      if (d.dot(information * d) > gate) continue;
-      best = v;
+  std::vector<float> dots(ncc.cols());
+  std::vector<double> scores(ncc.cols());
+  for (int y = 0; y < ncc.rows(); ++y) {
+    int first = 0;
+    while (first < ncc.cols() && !inside(first, y)) ++first;
+    int last = first;
+    while (last < ncc.cols() && inside(last, y)) ++last;
+    ncc.Row(y, first, last, &dots, &scores);
+    for (int x = first; x < last; ++x) {
+      if (scores[x] <= best) continue;
+      best = scores[x];
       at = cv::Point(x, y);
     }
   }
@@ -100,12 +196,8 @@ bool SearchPatch(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector
     return curvature < 0 ? std::clamp(0.5 * (l - r) / curvature, -0.5, 0.5) : 0.0;
   };
   double dx = 0, dy = 0;
-  if (at.x > 0 && at.x + 1 < score.cols) {
-    dx = offset(score.at<float>(at.y, at.x - 1), best, score.at<float>(at.y, at.x + 1));
-  }
-  if (at.y > 0 && at.y + 1 < score.rows) {
-    dy = offset(score.at<float>(at.y - 1, at.x), best, score.at<float>(at.y + 1, at.x));
-  }
+  if (at.x > 0 && at.x + 1 < ncc.cols()) dx = offset(ncc.At(at.x - 1, at.y), best, ncc.At(at.x + 1, at.y));
+  if (at.y > 0 && at.y + 1 < ncc.rows()) dy = offset(ncc.At(at.x, at.y - 1), best, ncc.At(at.x, at.y + 1));
   *found = Eigen::Vector2d(window.x + at.x + half + dx, window.y + at.y + half + dy);
   return true;
 }

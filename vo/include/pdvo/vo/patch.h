@@ -44,7 +44,9 @@ double Ncc(const cv::Mat& a, const cv::Mat& b);
 // inside the ellipse d^T S^-1 d <= search_sigmas^2 around `predicted` (also within max_search_radius px on
 // each axis) whose NCC is highest, refined per axis by a parabola through the scores of its neighbours
 // (at most half a pixel). `innovation` is S (px^2), the covariance of the predicted pixel plus the pixel noise.
-// False if no score in the ellipse reaches min_ncc or the search window leaves no room for the patch.
+// Only the positions inside the ellipse are scored, by direct sums (the same scores as OpenCV's matchTemplate
+// with TM_CCOEFF_NORMED, to float rounding; a quarter to a half of the window's positions). False if no score
+// in the ellipse reaches min_ncc, the patch is flat, or the search window leaves no room for the patch.
 bool SearchPatch(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector2d& predicted,
                  const Eigen::Matrix2d& innovation, const SearchOptions& options, Eigen::Vector2d* found);
 
