@@ -106,16 +106,8 @@ class WindowCorrelation {
   int cols() const { return cols_; }
   bool flat_patch() const { return !(patch_norm2_ > 1e-9); }
 
-  double At(int x, int y) const {
-    float dot = 0;
-    for (int r = 0; r < side_; ++r) {
-      const float* row = values_.data() + (y + r) * width_ + x;
-      for (int c = 0; c < side_; ++c) dot += row[c] * patch_[r * side_ + c];
-    }
-    return Normalised(dot, x, y);
-  }
-  // The NCCs at positions first .. last - 1 of row y, as At gives them (the same sums in the same order), into
-  // out[first .. last - 1]: summed for the whole run at once, which vectorises.
+  // The NCCs at positions first .. last - 1 of row y into out[first .. last - 1] (`dots` scratch, cols() long):
+  // summed for the whole run at once, which vectorises; each position's sums in the same order whatever the run.
   void Row(int y, int first, int last, std::vector<float>* dots, std::vector<double>* out) const {
     std::fill(dots->begin() + first, dots->begin() + last, 0.0f);
     for (int r = 0; r < side_; ++r) {
@@ -196,8 +188,12 @@ bool SearchPatch(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector
     return curvature < 0 ? std::clamp(0.5 * (l - r) / curvature, -0.5, 0.5) : 0.0;
   };
   double dx = 0, dy = 0;
-  if (at.x > 0 && at.x + 1 < ncc.cols()) dx = offset(ncc.At(at.x - 1, at.y), best, ncc.At(at.x + 1, at.y));
-  if (at.y > 0 && at.y + 1 < ncc.rows()) dy = offset(ncc.At(at.x, at.y - 1), best, ncc.At(at.x, at.y + 1));
+  auto score = [&](int x, int y) {  // a neighbour's, inside the ellipse or not
+    ncc.Row(y, x, x + 1, &dots, &scores);
+    return scores[x];
+  };
+  if (at.x > 0 && at.x + 1 < ncc.cols()) dx = offset(score(at.x - 1, at.y), best, score(at.x + 1, at.y));
+  if (at.y > 0 && at.y + 1 < ncc.rows()) dy = offset(score(at.x, at.y - 1), best, score(at.x, at.y + 1));
   *found = Eigen::Vector2d(window.x + at.x + half + dx, window.y + at.y + half + dy);
   return true;
 }

