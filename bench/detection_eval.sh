@@ -3,14 +3,16 @@
 # looking ahead, 511-518 looking around; 15 frames each at one frame a second, as ./run model renders them), and
 # the real sets of ../shared/data with reference annotations (Strecha, KITTI, TUM). One line per set: plane pixel
 # F1, false plane area, non-plane F1, plane recall within 30 / 10 degrees, median normal error of matched
-# planes, spurious planes per image, covering, ms per image.
+# planes, spurious planes per image, covering, the reference planes merged into larger detected planes (and onto
+# what, mostly: planes of their orientation / planes at another angle / non-plane / unannotated pixels), ms per
+# image.
 # With --validation, only the validation streets instead (seeds 601-603 ahead, 604-606 around, scored as one set:
 # where detector options are chosen, apart from the held-out ones).
 # Usage: bench/detection_eval.sh WORK [--validation] [--set key=value ...]   (detector options, e.g. --set mrf_planes=false)
 # e.g. bench/detection_eval.sh out/detection_eval
 set -euo pipefail
 if [ $# -lt 1 ]; then
-  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,10p'
+  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,11p'
   exit 2
 fi
 work=$1
@@ -58,9 +60,11 @@ score() {  # NAME FOLDER...
     /^  plane recall/ { r30 = $3; r10 = $7; refs = $12; spurious = $15 }
     /normal error/ { normal = $6 }
     /segmentation/ { covering = $11 }
+    /^  not matched/ { why = $3 " merged (" }
+    /^  merged, onto/ { why = why $7 "/" $12 "/" $14 "/" $17 ")" }
     END { printf "%-27s %4d images  plane F1 %s  false area %s  non-plane F1 %s  recall 30/10 %s/%s (of %s)  " \
-          "normal %s deg  spurious %.1f  covering %s  %s ms\n", name, images, f1, false_area, nf1, r30, r10, refs,
-          normal, spurious / images, covering, ms }' | tr -d ',;'
+          "normal %s deg  spurious %.1f  covering %s  %s  %s ms\n", name, images, f1, false_area, nf1, r30, r10, refs,
+          normal, spurious / images, covering, why, ms }' | tr -d ',;'
   rm -rf "$run"/* 
 }
 options=("$@")

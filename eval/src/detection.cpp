@@ -19,6 +19,17 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 // n choose 2.
 double Pairs(double n) { return 0.5 * n * (n - 1); }
+nlohmann::json Unmatched(int turned, int merged, int fragmented, int missed, const MergedWith& with) {
+  return {{"turned", turned},
+          {"merged", merged},
+          {"merged_with",
+           {{"parallel", with.parallel},
+            {"angled", with.angled},
+            {"nonplane", with.nonplane},
+            {"unannotated", with.unannotated}}},
+          {"fragmented", fragmented},
+          {"missed", missed}};
+}
 
 }  // namespace
 
@@ -30,6 +41,7 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
   // Per reference plane and per detected plane: pixel counts and their overlaps.
   std::map<int, long> ref_area, det_area;
   std::map<std::pair<int, int>, long> overlap;  // (reference shape, detected shape or -1) on reference planes
+  std::map<int, long> det_on_nonplane;          // per detected plane, its pixels on reference non-plane
   for (int y = 0; y < size.height; ++y) {
     const uchar* rl = ref.label.ptr<uchar>(y);
     const uchar* dl = det.label.ptr<uchar>(y);
@@ -43,6 +55,7 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
         ++ref_area[rs[x]];
         ++overlap[{rs[x], det_plane ? ds[x] : -1}];
       } else if (rl[x] == kMaskNonPlane) {
+        if (det_plane) ++det_on_nonplane[ds[x]];
         (det_plane ? s.nonplane_as_plane : det_nonplane ? s.nonplane_as_nonplane : s.nonplane_as_none) += 1;
       }
     }
@@ -58,12 +71,13 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     int best = -1;
     double best_iou = options.match_iou;
     long largest = 0, detected = 0;  // the largest overlap with one detected plane; all detected plane pixels on it
+    int largest_plane = -1;
     for (const auto& [key, inter] : overlap) {
       if (key.first != r || key.second < 0) continue;
       const int d = key.second;
       const double iou = inter / static_cast<double>(area + det_area[d] - inter);
       if (iou >= best_iou) best = d, best_iou = iou;
-      largest = std::max(largest, inter);
+      if (inter > largest) largest = inter, largest_plane = d;
       detected += inter;
     }
     double angle = 180;
@@ -80,6 +94,21 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     s.matched_30 += angle <= 30;
     if (angle <= 30) continue;
     (best >= 0 ? s.turned : 2 * largest >= area ? s.merged : 2 * detected >= area ? s.fragmented : s.missed) += 1;
+    if (best < 0 && 2 * largest >= area) {  // merged: where the rest of that detected plane lies
+      double parallel = 0, angled = 0;
+      for (const auto& [key, inter] : overlap) {
+        if (key.second != largest_plane || key.first == r) continue;
+        const AnnotationShape& other = reference.shapes[key.first];
+        (rs.normal && other.normal && AngleDeg(*rs.normal, *other.normal) <= 30 ? parallel : angled) += inter;
+      }
+      const double nonplane = det_on_nonplane[largest_plane];
+      const double unannotated = det_area[largest_plane] - largest - parallel - angled - nonplane;
+      const double most = std::max({parallel, angled, nonplane, unannotated});
+      (most == parallel   ? s.merged_with.parallel
+       : most == angled   ? s.merged_with.angled
+       : most == nonplane ? s.merged_with.nonplane
+                          : s.merged_with.unannotated) += 1;
+    }
   }
   for (const auto& [d, area] : det_area) s.spurious_planes += !det_matched[d];
   // Segmentation over the reference plane pixels, from the contingency table `overlap`.
@@ -130,6 +159,7 @@ DetectionSummary Summarise(const std::vector<DetectionScore>& scores) {
     errors.insert(errors.end(), s.normal_errors_deg.begin(), s.normal_errors_deg.end());
     m.spurious_planes += s.spurious_planes;
     m.turned += s.turned, m.merged += s.merged, m.fragmented += s.fragmented, m.missed += s.missed;
+    m.merged_with += s.merged_with;
     if (s.segmentation_pixels > 1) {
       ++segmented;
       m.rand_index += s.rand_index;
@@ -160,45 +190,42 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
   const DetectionSummary m = Summarise(scores);
   nlohmann::json images = nlohmann::json::array();
   for (const DetectionScore& s : scores) {
-    images.push_back(
-        {{"name", s.name},
-         {"pixels",
-          {{"plane_as_plane", s.plane_as_plane},
-           {"plane_as_nonplane", s.plane_as_nonplane},
-           {"plane_as_none", s.plane_as_none},
-           {"nonplane_as_plane", s.nonplane_as_plane},
-           {"nonplane_as_nonplane", s.nonplane_as_nonplane},
-           {"nonplane_as_none", s.nonplane_as_none}}},
-         {"reference_planes", s.reference_planes},
-         {"matched_10", s.matched_10},
-         {"matched_30", s.matched_30},
-         {"normal_errors_deg", s.normal_errors_deg},
-         {"spurious_planes", s.spurious_planes},
-         {"unmatched",
-          {{"turned", s.turned}, {"merged", s.merged}, {"fragmented", s.fragmented}, {"missed", s.missed}}},
-         {"rand_index", s.rand_index},
-         {"variation_of_information", s.variation_of_information},
-         {"covering", s.covering}});
+    images.push_back({{"name", s.name},
+                      {"pixels",
+                       {{"plane_as_plane", s.plane_as_plane},
+                        {"plane_as_nonplane", s.plane_as_nonplane},
+                        {"plane_as_none", s.plane_as_none},
+                        {"nonplane_as_plane", s.nonplane_as_plane},
+                        {"nonplane_as_nonplane", s.nonplane_as_nonplane},
+                        {"nonplane_as_none", s.nonplane_as_none}}},
+                      {"reference_planes", s.reference_planes},
+                      {"matched_10", s.matched_10},
+                      {"matched_30", s.matched_30},
+                      {"normal_errors_deg", s.normal_errors_deg},
+                      {"spurious_planes", s.spurious_planes},
+                      {"unmatched", Unmatched(s.turned, s.merged, s.fragmented, s.missed, s.merged_with)},
+                      {"rand_index", s.rand_index},
+                      {"variation_of_information", s.variation_of_information},
+                      {"covering", s.covering}});
   }
-  const nlohmann::json summary = {
-      {"images", m.images},
-      {"plane_precision", m.plane_precision},
-      {"plane_recall", m.plane_recall},
-      {"plane_f1", m.plane_f1},
-      {"nonplane_precision", m.nonplane_precision},
-      {"nonplane_recall", m.nonplane_recall},
-      {"nonplane_f1", m.nonplane_f1},
-      {"false_plane_area", m.false_plane_area},
-      {"reference_planes", m.reference_planes},
-      {"plane_recall_10", m.plane_recall_10},
-      {"plane_recall_30", m.plane_recall_30},
-      {"mean_normal_error_deg", m.mean_normal_error_deg},
-      {"median_normal_error_deg", m.median_normal_error_deg},
-      {"spurious_planes", m.spurious_planes},
-      {"unmatched", {{"turned", m.turned}, {"merged", m.merged}, {"fragmented", m.fragmented}, {"missed", m.missed}}},
-      {"rand_index", m.rand_index},
-      {"variation_of_information_bits", m.variation_of_information},
-      {"covering", m.covering}};
+  const nlohmann::json summary = {{"images", m.images},
+                                  {"plane_precision", m.plane_precision},
+                                  {"plane_recall", m.plane_recall},
+                                  {"plane_f1", m.plane_f1},
+                                  {"nonplane_precision", m.nonplane_precision},
+                                  {"nonplane_recall", m.nonplane_recall},
+                                  {"nonplane_f1", m.nonplane_f1},
+                                  {"false_plane_area", m.false_plane_area},
+                                  {"reference_planes", m.reference_planes},
+                                  {"plane_recall_10", m.plane_recall_10},
+                                  {"plane_recall_30", m.plane_recall_30},
+                                  {"mean_normal_error_deg", m.mean_normal_error_deg},
+                                  {"median_normal_error_deg", m.median_normal_error_deg},
+                                  {"spurious_planes", m.spurious_planes},
+                                  {"unmatched", Unmatched(m.turned, m.merged, m.fragmented, m.missed, m.merged_with)},
+                                  {"rand_index", m.rand_index},
+                                  {"variation_of_information_bits", m.variation_of_information},
+                                  {"covering", m.covering}};
   const std::string how =
       "pixels scored where the reference annotates; planes matched by IoU >= " + std::to_string(options.match_iou) +
       "; plane recall over reference planes of at least " + std::to_string(options.min_plane_share) + " of the image";

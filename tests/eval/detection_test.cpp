@@ -1,7 +1,7 @@
 // Detection scores on hand-made annotations with known answers: a perfect detection; one plane over the whole
 // image with a turned normal (half its area false, matched within 30 degrees but not 10); a plane detected as two
 // halves (Rand index about one half, one bit of variation of information, covering one half); why planes are not
-// matched.
+// matched, and what a merged plane runs onto.
 #include "pdvo/eval/detection.h"
 
 #include <gtest/gtest.h>
@@ -100,6 +100,30 @@ TEST(DetectionScore, SaysWhyAPlaneIsNotMatched) {
   EXPECT_EQ(unmatched(ScoreDetection(Reference(), Image({Rect(kPlaneLabel, -0.5, -0.5, 49.5, 79.5, turned)}))),
             (std::vector<int>{0, 0, 0, 1}));
   EXPECT_EQ(unmatched(ScoreDetection(Reference(), Reference())), (std::vector<int>{0, 0, 0, 0}));
+}
+
+// Where a merged plane runs: the reference plane is columns 0-24 (facing the camera); the detected plane covers
+// columns 0-74, whose columns 25-74 are, in turn, a plane of the same orientation, a plane turned 60 degrees, a
+// non-plane, and not annotated.
+TEST(DetectionScore, SaysWhatAMergedPlaneRunsOnto) {
+  const Eigen::Vector3d angled(std::sin(60 * M_PI / 180), 0, -std::cos(60 * M_PI / 180));
+  const AnnotationShape plane = Rect(kPlaneLabel, -0.5, -0.5, 24.5, 79.5, kFacing);
+  const Annotation detection = Image({Rect(kPlaneLabel, -0.5, -0.5, 74.5, 79.5, kFacing)});
+  const auto merged_with = [&](std::vector<AnnotationShape> rest) {
+    rest.insert(rest.begin(), plane);
+    const DetectionScore s = ScoreDetection(Image(rest), detection);
+    EXPECT_EQ(s.merged, 1);
+    const MergedWith& w = s.merged_with;
+    return std::vector<int>{w.parallel, w.angled, w.nonplane, w.unannotated};
+  };
+  EXPECT_EQ(merged_with({Rect(kPlaneLabel, 24.5, -0.5, 74.5, 79.5, kFacing)}), (std::vector<int>{1, 0, 0, 0}));
+  EXPECT_EQ(merged_with({Rect(kPlaneLabel, 24.5, -0.5, 74.5, 79.5, angled)}), (std::vector<int>{0, 1, 0, 0}));
+  EXPECT_EQ(merged_with({Rect(kNonPlaneLabel, 24.5, -0.5, 74.5, 79.5)}), (std::vector<int>{0, 0, 1, 0}));
+  EXPECT_EQ(merged_with({}), (std::vector<int>{0, 0, 0, 1}));
+  // Counted in the summary and the JSON.
+  const DetectionScore s = ScoreDetection(Image({plane, Rect(kNonPlaneLabel, 24.5, -0.5, 74.5, 79.5)}), detection);
+  EXPECT_EQ(Summarise({s, s}).merged_with.nonplane, 2);
+  EXPECT_EQ(ToJson({s}, {})["summary"]["unmatched"]["merged_with"]["nonplane"], 1);
 }
 
 }  // namespace

@@ -12,7 +12,10 @@
 //   each counted reference plane that is not matched within 30 degrees is put down to one cause: its best match's
 //   normal is over 30 degrees off (turned); the detected plane overlapping it most holds at least half of it but is
 //   too large for IoU match_iou (merged: it runs onto other planes or non-planes); detected planes cover at least
-//   half of it, but none half (fragmented); less than half of it is detected as plane (missed);
+//   half of it, but none half (fragmented); less than half of it is detected as plane (missed); a merged plane is
+//   put down to where most of that detected plane's area outside it lies: on reference planes of its orientation
+//   (within 30 degrees: a neighbouring facade), on reference planes at another angle (a wall round a corner, the
+//   ground), on reference non-plane pixels, or on unannotated pixels;
 // - segmentation over the reference's plane pixels, each reference plane a segment and each detected plane a
 //   segment (pixels on no detected plane one more): Rand index, variation of information (bits), and the
 //   covering of the reference by the detection (each reference segment's best IoU, weighted by its size).
@@ -32,6 +35,15 @@ struct DetectionScoreOptions {
   double match_iou = 0.5;
 };
 
+// Merged reference planes by where most of the detected plane's area outside them lies (see above).
+struct MergedWith {
+  int parallel = 0, angled = 0, nonplane = 0, unannotated = 0;
+  MergedWith& operator+=(const MergedWith& o) {
+    parallel += o.parallel, angled += o.angled, nonplane += o.nonplane, unannotated += o.unannotated;
+    return *this;
+  }
+};
+
 struct DetectionScore {
   std::string name;
   // Pixel counts on annotated pixels: reference label x detected label (plane, non-plane, none).
@@ -42,6 +54,7 @@ struct DetectionScore {
   std::vector<double> normal_errors_deg;  // of the reference planes matched by IoU (any angle, any size)
   int spurious_planes = 0;                // detected planes that are no reference plane's match
   int turned = 0, merged = 0, fragmented = 0, missed = 0;  // counted reference planes not matched within 30 degrees
+  MergedWith merged_with;
   double rand_index = 1, variation_of_information = 0, covering = 1;  // 1, 0, 1 without reference planes
   long segmentation_pixels = 0;  // the reference plane pixels the segmentation figures are over
 };
@@ -60,6 +73,7 @@ struct DetectionSummary {
   double mean_normal_error_deg = 0, median_normal_error_deg = 0;  // over matched planes
   int spurious_planes = 0;
   int turned = 0, merged = 0, fragmented = 0, missed = 0;
+  MergedWith merged_with;
   double rand_index = 0, variation_of_information = 0, covering = 0;  // means over images with plane pixels
 };
 DetectionSummary Summarise(const std::vector<DetectionScore>& scores);
