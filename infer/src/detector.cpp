@@ -12,6 +12,7 @@
 
 #include "pdvo/common/errors.h"
 #include "pdvo/common/options.h"
+#include "pdvo/infer/column_cuts.h"
 #include "pdvo/infer/mrf.h"
 #include "pdvo/infer/sphere.h"
 #include "pdvo/infer/vanishing.h"
@@ -24,7 +25,7 @@ constexpr double kDegree = M_PI / 180;
 constexpr double kMinProbability = 1e-3;   // MRF 1's data terms: -log of probabilities clamped to this
 constexpr double kMaxOrientationCost = 4;  // MRF 2's data cost, at most
 constexpr int kMinColumnPixels = 8;        // a column of a plane's area with fewer pixels has no colour of its own
-constexpr int kMinPartPoints = 3;          // a part of a plane split by colour is kept down to this many points
+constexpr int kMinPartPoints = 3;          // a part of a split plane is kept down to this many points
 
 using Clock = std::chrono::steady_clock;
 double Ms(Clock::time_point from) { return std::chrono::duration<double, std::milli>(Clock::now() - from).count(); }
@@ -112,61 +113,6 @@ std::vector<std::vector<int>> Components(int n, const std::vector<std::pair<int,
 
 }  // namespace
 
-std::vector<int> ColourColumnCuts(const cv::Mat& lab, const cv::Mat& mask, double penalty, int min_width,
-                                  int min_pixels) {
-  PDVO_THROW_CHECK(lab.type() == CV_32FC3 && mask.type() == CV_8U && lab.size() == mask.size(), InvalidArgument,
-                   "colour columns: expected a CV_32FC3 image and a CV_8U mask of its size");
-  std::vector<int> column;              // the columns with enough pixels
-  std::vector<Eigen::Vector3d> colour;  // and their median colours
-  std::vector<float> channel[3];
-  const cv::Rect box = cv::boundingRect(mask);  // the columns and rows outside it hold no pixel of the mask
-  cv::Mat lab_columns, mask_columns;            // transposed: a column is a row, read in memory order
-  cv::transpose(lab(box), lab_columns);
-  cv::transpose(mask(box), mask_columns);
-  for (int x = box.x; x < box.x + box.width; ++x) {
-    for (auto& c : channel) c.clear();
-    const uchar* in = mask_columns.ptr<uchar>(x - box.x);
-    const cv::Vec3f* values = lab_columns.ptr<cv::Vec3f>(x - box.x);
-    for (int y = 0; y < box.height; ++y) {
-      if (!in[y]) continue;
-      for (int k = 0; k < 3; ++k) channel[k].push_back(values[y][k]);
-    }
-    if (static_cast<int>(channel[0].size()) < min_pixels) continue;
-    Eigen::Vector3d median;
-    for (int k = 0; k < 3; ++k) {
-      std::nth_element(channel[k].begin(), channel[k].begin() + channel[k].size() / 2, channel[k].end());
-      median[k] = channel[k][channel[k].size() / 2];
-    }
-    column.push_back(x);
-    colour.push_back(median);
-  }
-  const int m = static_cast<int>(column.size());
-  if (m == 0) return {};
-  std::vector<Eigen::Vector3d> sum(m + 1, Eigen::Vector3d::Zero());
-  std::vector<double> squares(m + 1, 0);
-  for (int i = 0; i < m; ++i) sum[i + 1] = sum[i] + colour[i], squares[i + 1] = squares[i] + colour[i].squaredNorm();
-  auto cost = [&](int i, int j) {  // columns i..j-1 as one run
-    const Eigen::Vector3d s = sum[j] - sum[i];
-    return squares[j] - squares[i] - s.squaredNorm() / (j - i);
-  };
-  // best[j]: the least cost of columns 0..j-1 as runs; from[j]: where its last run starts.
-  std::vector<double> best(m + 1, std::numeric_limits<double>::infinity());
-  std::vector<int> from(m + 1, 0);
-  best[0] = 0;
-  for (int j = 1; j <= m; ++j) {
-    for (int i = 0; i < j; ++i) {
-      const bool wide = column[j - 1] - column[i] + 1 >= min_width;
-      if (!wide && !(i == 0 && j == m)) continue;  // too narrow a run, unless it is the whole
-      const double c = best[i] + cost(i, j) + penalty;
-      if (c < best[j]) best[j] = c, from[j] = i;
-    }
-  }
-  std::vector<int> cuts;
-  for (int j = m; from[j] > 0; j = from[j]) cuts.push_back(column[from[j]]);
-  std::reverse(cuts.begin(), cuts.end());
-  return cuts;
-}
-
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
                          double normal_scale_deg) {
   const size_t n = points.size();
@@ -230,7 +176,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(distance_scale > 0 && colour_scale > 0 && plane_smoothness >= 0);
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
-  PDVO_CHECK_OPTION(column_split_penalty >= 0 && column_split_width >= 1);
+  PDVO_CHECK_OPTION(column_split_penalty >= 0 && azimuth_split_penalty >= 0 && column_split_width >= 1);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
   PDVO_CHECK_OPTION(cell_radius > 0);
   PDVO_CHECK_OPTION(point_quality > 0 && point_quality < 1 && point_min_distance >= 1);
@@ -432,7 +378,9 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     return s;
   };
   cv::Mat lab;
-  if (o.column_split_penalty > 0) {
+  const ColumnCutOptions column_cuts{o.column_split_penalty, o.azimuth_split_penalty, o.column_split_width,
+                                     kMinColumnPixels};
+  if (o.column_split_penalty > 0 || o.azimuth_split_penalty > 0) {
     work.convertTo(lab, CV_32F, 1.0 / 255);
     cv::cvtColor(lab, lab, cv::COLOR_BGR2Lab);
   }
@@ -440,12 +388,12 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     if (static_cast<int>(members.size()) < o.min_segment_points) continue;
     std::optional<DetectedSegment> s = plane_of(members, area_of(members));
     if (!s) continue;
-    // A vertical plane is split where its colour changes along the image's columns (one facade meeting the next):
-    // each part, its points and its area within a run of columns, is recognised again, and takes the whole's
-    // recognition if its own fails.
+    // A vertical plane is split where its colour changes or its edges turn along the image's columns (one facade
+    // meeting the next, FacadeColumnCuts): each part, its points and its area within a run of columns, is recognised
+    // again, and takes the whole's recognition if its own fails.
     std::vector<int> cuts;
-    if (o.column_split_penalty > 0 && std::abs(s->normal.dot(words.edges.up)) < model.options.vanishing.horizontal_cos)
-      cuts = ColourColumnCuts(lab, s->mask, o.column_split_penalty, o.column_split_width, kMinColumnPixels);
+    if (!lab.empty() && std::abs(s->normal.dot(words.edges.up)) < model.options.vanishing.horizontal_cos)
+      cuts = FacadeColumnCuts(lab, words.edges, s->mask, column_cuts, model.options.vanishing);
     if (cuts.empty()) {
       d.segments.push_back(std::move(*s));
       continue;

@@ -172,12 +172,17 @@ double AzimuthLikelihood::Phi(const Eigen::Vector3d& n) const {
   return phi >= M_PI ? phi - M_PI : phi;
 }
 
-AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region, const VanishingOptions& o) {
+AzimuthLikelihood AzimuthBasis(const EdgePlanes& edges, const VanishingOptions& o) {
   AzimuthLikelihood l;
   l.up = edges.up;
   l.e1 = (Eigen::Vector3d::UnitX() - edges.up.x() * edges.up).normalized();
   l.e2 = l.e1.cross(edges.up);
   l.residual_scale = o.residual_scale;
+  return l;
+}
+
+AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region, const VanishingOptions& o) {
+  AzimuthLikelihood l = AzimuthBasis(edges, o);
   if (!edges.up_found) return l;
   const Eigen::Vector3f up = edges.up.cast<float>(), e1 = l.e1.cast<float>(), e2 = l.e2.cast<float>();
   const float vertical_sin = static_cast<float>(std::sin(o.vertical_band_deg * kDegree));

@@ -91,6 +91,8 @@ struct AzimuthLikelihood {
 };
 AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region,
                                           const VanishingOptions& options);
+// Without constraints: the image's vertical, the basis e1, e2 of the horizontal and the residual scale.
+AzimuthLikelihood AzimuthBasis(const EdgePlanes& edges, const VanishingOptions& options);
 
 // How much of a region lies on straight edges, a cue to man-made planes: the share of its pixels on coherent
 // edges, and the share of their strength on vertical lines (see vertical_band_deg; without a vertical found, the
