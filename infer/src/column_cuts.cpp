@@ -109,7 +109,8 @@ std::vector<int> FacadeColumnCuts(const cv::Mat& lab, const EdgePlanes& edges, c
                                   const ColumnCutOptions& cut, const VanishingOptions& o) {
   PDVO_THROW_CHECK(lab.type() == CV_32FC3 && mask.type() == CV_8U && lab.size() == mask.size() &&
                        (edges.normals.empty() || edges.normals.size() == mask.size()),
-                   InvalidArgument, "facade columns: expected a CV_32FC3 image and a CV_8U mask (and edges) of its size");
+                   InvalidArgument,
+                   "facade columns: expected a CV_32FC3 image and a CV_8U mask (and edges) of its size");
   PDVO_THROW_CHECK(cut.colour_penalty >= 0 && cut.azimuth_penalty >= 0, InvalidArgument,
                    "facade columns: negative penalty");
   if (cut.colour_penalty == 0 && cut.azimuth_penalty == 0) return {};

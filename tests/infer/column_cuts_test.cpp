@@ -105,33 +105,34 @@ TEST(FacadeColumnCuts, AreOptimal) {
       edges.strength.at<float>(0, x) = 10;  // all of mean strength
     }
     const bool edges_count = cut.azimuth_penalty > 0;
-    const auto cost = [&](const std::vector<int>& cuts) {  // per run: colour / colour_penalty + turn / azimuth_penalty + 1
-      std::vector<int> bounds = {0};
-      bounds.insert(bounds.end(), cuts.begin(), cuts.end());
-      bounds.push_back(m);
-      double total = 0;
-      for (size_t r = 0; r + 1 < bounds.size(); ++r) {
-        cv::Vec3d mean(0, 0, 0);
-        for (int x = bounds[r]; x < bounds[r + 1]; ++x) mean += cv::Vec3d(lab.at<cv::Vec3f>(0, x));
-        mean /= bounds[r + 1] - bounds[r];
-        double colour = 0, turn = std::numeric_limits<double>::infinity();
-        for (int x = bounds[r]; x < bounds[r + 1]; ++x) {
-          const cv::Vec3d d = cv::Vec3d(lab.at<cv::Vec3f>(0, x)) - mean;
-          colour += d.dot(d);
-        }
-        for (int k = 0; k < 36; ++k) {  // the directions it tries
-          const double p = (k + 0.5) * M_PI / 36;
-          double loss = 0;
-          for (int x = bounds[r]; x < bounds[r + 1]; ++x) {
-            const double residual = 0.8 * std::sin(phi[x] - p) / v.residual_scale;  // m . d(p)
-            loss += std::log1p(residual * residual);
+    const auto cost =
+        [&](const std::vector<int>& cuts) {  // per run: colour / colour_penalty + turn / azimuth_penalty + 1
+          std::vector<int> bounds = {0};
+          bounds.insert(bounds.end(), cuts.begin(), cuts.end());
+          bounds.push_back(m);
+          double total = 0;
+          for (size_t r = 0; r + 1 < bounds.size(); ++r) {
+            cv::Vec3d mean(0, 0, 0);
+            for (int x = bounds[r]; x < bounds[r + 1]; ++x) mean += cv::Vec3d(lab.at<cv::Vec3f>(0, x));
+            mean /= bounds[r + 1] - bounds[r];
+            double colour = 0, turn = std::numeric_limits<double>::infinity();
+            for (int x = bounds[r]; x < bounds[r + 1]; ++x) {
+              const cv::Vec3d d = cv::Vec3d(lab.at<cv::Vec3f>(0, x)) - mean;
+              colour += d.dot(d);
+            }
+            for (int k = 0; k < 36; ++k) {  // the directions it tries
+              const double p = (k + 0.5) * M_PI / 36;
+              double loss = 0;
+              for (int x = bounds[r]; x < bounds[r + 1]; ++x) {
+                const double residual = 0.8 * std::sin(phi[x] - p) / v.residual_scale;  // m . d(p)
+                loss += std::log1p(residual * residual);
+              }
+              turn = std::min(turn, loss);
+            }
+            total += colour / cut.colour_penalty + (edges_count ? turn / cut.azimuth_penalty : 0) + 1;
           }
-          turn = std::min(turn, loss);
-        }
-        total += colour / cut.colour_penalty + (edges_count ? turn / cut.azimuth_penalty : 0) + 1;
-      }
-      return total;
-    };
+          return total;
+        };
     double best = std::numeric_limits<double>::infinity();
     for (int set = 0; set < (1 << std::max(0, m - 1)); ++set) {  // bit k: a cut before column k + 1
       std::vector<int> cuts;
