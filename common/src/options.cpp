@@ -129,10 +129,17 @@ void ParseScalar(const std::string& text, const std::string& where, double& valu
 void ParseScalar(const std::string& text, const std::string&, std::string& value) { value = text; }
 
 void ParseScalar(const std::string& text, const std::string& where, std::vector<double>& value) {
+  // Numbers separated by commas, with or without the brackets and spaces the options files write: 1,2 or [1, 2].
+  auto trim = [](const std::string& t) {
+    const size_t first = t.find_first_not_of(" \t"), last = t.find_last_not_of(" \t");
+    return first == std::string::npos ? std::string() : t.substr(first, last - first + 1);
+  };
+  std::string list = trim(text);
+  if (list.size() >= 2 && list.front() == '[' && list.back() == ']') list = trim(list.substr(1, list.size() - 2));
   std::vector<double> parsed;  // assigned only when every item is a number: a failed override changes nothing
-  std::stringstream ss(text);
+  std::stringstream ss(list);
   std::string item;
-  while (std::getline(ss, item, ',')) parsed.push_back(ParseDouble(item, where));
+  while (std::getline(ss, item, ',')) parsed.push_back(ParseDouble(trim(item), where));
   value = std::move(parsed);
 }
 

@@ -211,6 +211,11 @@ TEST(Options, OverridesSetNestedFields) {
   EXPECT_FALSE(o.enabled);
   EXPECT_DOUBLE_EQ(o.threshold, 1e-3);
   EXPECT_EQ(o.inner.weights, (std::vector<double>{1, 2, 3}));
+  ApplyOverrides(o, {"inner.weights=[4, 5.5]"});  // as the options files write lists
+  EXPECT_EQ(o.inner.weights, (std::vector<double>{4, 5.5}));
+  EXPECT_THROW(ApplyOverrides(o, {"inner.weights=[4, x]"}), InvalidArgument);
+  EXPECT_THROW(ApplyOverrides(o, {"inner.weights=[4, 5"}), InvalidArgument);
+  EXPECT_EQ(o.inner.weights, (std::vector<double>{4, 5.5}));  // a failed override changes nothing
   EXPECT_THROW(ApplyOverrides(o, {"inner.nope=1"}), InvalidArgument);
   EXPECT_THROW(ApplyOverrides(o, {"threshold=abc"}), InvalidArgument);
   EXPECT_THROW(ApplyOverrides(o, {"inner=3"}), InvalidArgument);
