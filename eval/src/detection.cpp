@@ -19,6 +19,7 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 // n choose 2.
 double Pairs(double n) { return 0.5 * n * (n - 1); }
+// Why reference planes were not matched, as JSON.
 nlohmann::json Unmatched(int turned, int merged, int fragmented, int missed, const MergedWith& with) {
   return {{"turned", turned},
           {"merged", merged},
