@@ -68,12 +68,13 @@ int RunEvaluateDetection(int argc, char** argv) {
               m.nonplane_f1);
   std::printf("  plane recall      %.3f within 30 deg, %.3f within 10 deg (of %d reference planes); %d spurious\n",
               m.plane_recall_30, m.plane_recall_10, m.reference_planes, m.spurious_planes);
-  std::printf("  not matched       %d merged, %d fragmented, %d missed, %d turned over 30 deg\n", m.merged,
-              m.fragmented, m.missed, m.turned);
+  std::printf("  not matched       %d merged, %d fragmented, %d missed, %d turned over 30 deg\n", m.unmatched.merged(),
+              m.unmatched.fragmented, m.unmatched.missed, m.unmatched.turned);
   std::printf(
       "  merged, onto     planes of its orientation %d, planes at another angle %d, non-plane %d, "
       "unannotated pixels %d\n",
-      m.merged_with.parallel, m.merged_with.angled, m.merged_with.nonplane, m.merged_with.unannotated);
+      m.unmatched.merged_parallel, m.unmatched.merged_angled, m.unmatched.merged_nonplane,
+      m.unmatched.merged_unannotated);
   std::printf("  normal error      mean %.1f, median %.1f deg (matched planes)\n", m.mean_normal_error_deg,
               m.median_normal_error_deg);
   std::printf("  segmentation      Rand index %.3f, variation of information %.3f bits, covering %.3f\n", m.rand_index,

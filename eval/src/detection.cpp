@@ -19,20 +19,26 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 // n choose 2.
 double Pairs(double n) { return 0.5 * n * (n - 1); }
-// Why reference planes were not matched, as JSON.
-nlohmann::json Unmatched(int turned, int merged, int fragmented, int missed, const MergedWith& with) {
-  return {{"turned", turned},
-          {"merged", merged},
+nlohmann::json ToJson(const Unmatched& u) {
+  return {{"turned", u.turned},
+          {"merged", u.merged()},
           {"merged_with",
-           {{"parallel", with.parallel},
-            {"angled", with.angled},
-            {"nonplane", with.nonplane},
-            {"unannotated", with.unannotated}}},
-          {"fragmented", fragmented},
-          {"missed", missed}};
+           {{"parallel", u.merged_parallel},
+            {"angled", u.merged_angled},
+            {"nonplane", u.merged_nonplane},
+            {"unannotated", u.merged_unannotated}}},
+          {"fragmented", u.fragmented},
+          {"missed", u.missed}};
 }
 
 }  // namespace
+
+Unmatched& Unmatched::operator+=(const Unmatched& o) {
+  turned += o.turned, fragmented += o.fragmented, missed += o.missed;
+  merged_parallel += o.merged_parallel, merged_angled += o.merged_angled;
+  merged_nonplane += o.merged_nonplane, merged_unannotated += o.merged_unannotated;
+  return *this;
+}
 
 DetectionScore ScoreDetection(const Annotation& reference, const Annotation& detection,
                               const DetectionScoreOptions& options) {
@@ -94,8 +100,10 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     s.matched_10 += angle <= 10;
     s.matched_30 += angle <= 30;
     if (angle <= 30) continue;
-    (best >= 0 ? s.turned : 2 * largest >= area ? s.merged : 2 * detected >= area ? s.fragmented : s.missed) += 1;
-    if (best < 0 && 2 * largest >= area) {  // merged: where the rest of that detected plane lies
+    Unmatched& u = s.unmatched;
+    if (best >= 0) {
+      ++u.turned;
+    } else if (2 * largest >= area) {  // merged: put down to where the rest of that detected plane lies
       double parallel = 0, angled = 0;
       for (const auto& [key, inter] : overlap) {
         if (key.second != largest_plane || key.first == r) continue;
@@ -105,10 +113,12 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
       const double nonplane = det_on_nonplane[largest_plane];
       const double unannotated = det_area[largest_plane] - largest - parallel - angled - nonplane;
       const double most = std::max({parallel, angled, nonplane, unannotated});
-      (most == parallel   ? s.merged_with.parallel
-       : most == angled   ? s.merged_with.angled
-       : most == nonplane ? s.merged_with.nonplane
-                          : s.merged_with.unannotated) += 1;
+      ++(most == parallel   ? u.merged_parallel
+         : most == angled   ? u.merged_angled
+         : most == nonplane ? u.merged_nonplane
+                            : u.merged_unannotated);
+    } else {
+      ++(2 * detected >= area ? u.fragmented : u.missed);
     }
   }
   for (const auto& [d, area] : det_area) s.spurious_planes += !det_matched[d];
@@ -159,8 +169,7 @@ DetectionSummary Summarise(const std::vector<DetectionScore>& scores) {
     matched_10 += s.matched_10, matched_30 += s.matched_30;
     errors.insert(errors.end(), s.normal_errors_deg.begin(), s.normal_errors_deg.end());
     m.spurious_planes += s.spurious_planes;
-    m.turned += s.turned, m.merged += s.merged, m.fragmented += s.fragmented, m.missed += s.missed;
-    m.merged_with += s.merged_with;
+    m.unmatched += s.unmatched;
     if (s.segmentation_pixels > 1) {
       ++segmented;
       m.rand_index += s.rand_index;
@@ -204,7 +213,7 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
                       {"matched_30", s.matched_30},
                       {"normal_errors_deg", s.normal_errors_deg},
                       {"spurious_planes", s.spurious_planes},
-                      {"unmatched", Unmatched(s.turned, s.merged, s.fragmented, s.missed, s.merged_with)},
+                      {"unmatched", ToJson(s.unmatched)},
                       {"rand_index", s.rand_index},
                       {"variation_of_information", s.variation_of_information},
                       {"covering", s.covering}});
@@ -223,7 +232,7 @@ nlohmann::json ToJson(const std::vector<DetectionScore>& scores, const Detection
                                   {"mean_normal_error_deg", m.mean_normal_error_deg},
                                   {"median_normal_error_deg", m.median_normal_error_deg},
                                   {"spurious_planes", m.spurious_planes},
-                                  {"unmatched", Unmatched(m.turned, m.merged, m.fragmented, m.missed, m.merged_with)},
+                                  {"unmatched", ToJson(m.unmatched)},
                                   {"rand_index", m.rand_index},
                                   {"variation_of_information_bits", m.variation_of_information},
                                   {"covering", m.covering}};

@@ -63,13 +63,11 @@ AzimuthTable ColumnAzimuths(const EdgePlanes& edges, const cv::Mat& mask, const 
   const int m = static_cast<int>(column.size());
   std::vector<int> index(mask.cols, -1);
   for (int i = 0; i < m; ++i) index[column[i]] = i;
-  // The edges off the vertical in the columns: their column, (m . e1, m . e2) and strength.
-  const AzimuthLikelihood basis = AzimuthBasis(edges, o);
-  const Eigen::Vector3f up = basis.up.cast<float>(), e1 = basis.e1.cast<float>(), e2 = basis.e2.cast<float>();
+  // The mask's edges off the vertical as constraints on phi (AzimuthLikelihood), and each one's column.
+  AzimuthLikelihood edges_phi = AzimuthBasis(edges, o);
+  const Eigen::Vector3f up = edges.up.cast<float>(), e1 = edges_phi.e1.cast<float>(), e2 = edges_phi.e2.cast<float>();
   const float vertical_sin = static_cast<float>(std::sin(o.vertical_band_deg * M_PI / 180));
   std::vector<int> edge_column;
-  std::vector<Eigen::Vector2f> constraint;
-  std::vector<float> weight;
   const cv::Rect box = cv::boundingRect(mask);
   for (int y = box.y; y < box.y + box.height; ++y) {
     const uchar* in = mask.ptr<uchar>(y);
@@ -80,24 +78,22 @@ AzimuthTable ColumnAzimuths(const EdgePlanes& edges, const cv::Mat& mask, const 
       const Eigen::Vector3f n(normal[x][0], normal[x][1], normal[x][2]);
       if (std::abs(n.dot(up)) < vertical_sin) continue;  // a vertical line: says nothing of the azimuth
       edge_column.push_back(index[x]);
-      constraint.emplace_back(n.dot(e1), n.dot(e2));
-      weight.push_back(strength[x]);
+      edges_phi.constraints.emplace_back(n.dot(e1), n.dot(e2));
+      edges_phi.weights.push_back(strength[x]);
     }
   }
-  if (static_cast<int>(weight.size()) < o.min_edges) return table;
+  if (static_cast<int>(edge_column.size()) < o.min_edges) return table;
   double mean_strength = 0;
-  for (const float w : weight) mean_strength += w;
-  mean_strength /= static_cast<double>(weight.size());
-  Eigen::Matrix<float, 2, kAzimuthSteps> d;
-  for (int k = 0; k < kAzimuthSteps; ++k) {
-    const double phi = (k + 0.5) * M_PI / kAzimuthSteps;
-    d.col(k) = Eigen::Vector2f(std::cos(phi), std::sin(phi)) / static_cast<float>(o.residual_scale);
-  }
+  for (const float w : edges_phi.weights) mean_strength += w;
+  mean_strength /= static_cast<double>(edge_column.size());
+  std::vector<double> phis(kAzimuthSteps);
+  for (int k = 0; k < kAzimuthSteps; ++k) phis[k] = (k + 0.5) * M_PI / kAzimuthSteps;
+  const Eigen::ArrayXXf losses = edges_phi.Losses(phis);  // edges x phis
   table.total = Eigen::Matrix<double, kAzimuthSteps, Eigen::Dynamic>::Zero(kAzimuthSteps, m + 1);
-  for (size_t e = 0; e < weight.size(); ++e) {
-    const Eigen::Array<float, 1, kAzimuthSteps> r = constraint[e].transpose() * d;
-    const Eigen::Array<float, 1, kAzimuthSteps> loss = (r * r).log1p() * static_cast<float>(weight[e] / mean_strength);
-    table.total.col(edge_column[e] + 1) += loss.matrix().transpose().cast<double>();
+  for (size_t e = 0; e < edge_column.size(); ++e) {
+    const double weight = edges_phi.weights[e] / mean_strength;
+    table.total.col(edge_column[e] + 1) +=
+        (losses.row(static_cast<Eigen::Index>(e)).transpose().cast<double>() * weight).matrix();
   }
   for (int i = 0; i < m; ++i) table.total.col(i + 1) += table.total.col(i);
   return table;

@@ -139,19 +139,24 @@ Eigen::Vector2d EdgeStructure(const EdgePlanes& edges, const Region& region, con
   return {count / area, strength > 0 ? vertical / strength : 0.0};
 }
 
-std::vector<double> AzimuthLikelihood::MeanLogLikelihoods(const std::vector<double>& phis) const {
+Eigen::ArrayXXf AzimuthLikelihood::Losses(const std::vector<double>& phis) const {
   PDVO_THROW_CHECK(!empty(), InvalidArgument, "azimuth likelihood: no edges");
   // All the residuals in one matrix product and their logarithms several at a time (most of FuseNormal's time).
   const Eigen::Index n = static_cast<Eigen::Index>(constraints.size()), k = static_cast<Eigen::Index>(phis.size());
   const Eigen::Map<const Eigen::Matrix<float, 2, Eigen::Dynamic>> m(constraints.front().data(), 2, n);
-  const Eigen::Map<const Eigen::VectorXf> w(weights.data(), n);
   Eigen::Matrix<float, 2, Eigen::Dynamic> d(2, k);
   for (Eigen::Index j = 0; j < k; ++j) {
     d(0, j) = static_cast<float>(std::cos(phis[static_cast<size_t>(j)]) / residual_scale);
     d(1, j) = static_cast<float>(std::sin(phis[static_cast<size_t>(j)]) / residual_scale);
   }
   const Eigen::ArrayXXf r = (m.transpose() * d).array();  // n x k
-  const Eigen::ArrayXXf logs = (r * r).log1p();
+  return (r * r).log1p();
+}
+
+std::vector<double> AzimuthLikelihood::MeanLogLikelihoods(const std::vector<double>& phis) const {
+  const Eigen::ArrayXXf logs = Losses(phis);
+  const Eigen::Index n = logs.rows(), k = logs.cols();
+  const Eigen::Map<const Eigen::VectorXf> w(weights.data(), n);
   const Eigen::VectorXd sums = logs.matrix().cast<double>().transpose() * w.cast<double>();
   const double mass = w.cast<double>().sum();
   std::vector<double> out(static_cast<size_t>(k));

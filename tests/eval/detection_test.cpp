@@ -82,7 +82,8 @@ TEST(DetectionScore, APlaneInTwoHalves) {
 // plane itself with a normal 40 degrees off: turned.
 TEST(DetectionScore, SaysWhyAPlaneIsNotMatched) {
   const auto unmatched = [](const DetectionScore& s) {
-    return std::vector<int>{s.merged, s.fragmented, s.missed, s.turned};
+    const Unmatched& u = s.unmatched;
+    return std::vector<int>{u.merged(), u.fragmented, u.missed, u.turned};
   };
   const Eigen::Vector3d turned(std::sin(40 * M_PI / 180), 0, -std::cos(40 * M_PI / 180));
   Annotation wide = Image({Rect(kPlaneLabel, -0.5, -0.5, 124.5, 79.5, kFacing)});
@@ -112,9 +113,9 @@ TEST(DetectionScore, SaysWhatAMergedPlaneRunsOnto) {
   const auto merged_with = [&](std::vector<AnnotationShape> rest) {
     rest.insert(rest.begin(), plane);
     const DetectionScore s = ScoreDetection(Image(rest), detection);
-    EXPECT_EQ(s.merged, 1);
-    const MergedWith& w = s.merged_with;
-    return std::vector<int>{w.parallel, w.angled, w.nonplane, w.unannotated};
+    const Unmatched& u = s.unmatched;
+    EXPECT_EQ(u.merged(), 1);
+    return std::vector<int>{u.merged_parallel, u.merged_angled, u.merged_nonplane, u.merged_unannotated};
   };
   EXPECT_EQ(merged_with({Rect(kPlaneLabel, 24.5, -0.5, 74.5, 79.5, kFacing)}), (std::vector<int>{1, 0, 0, 0}));
   EXPECT_EQ(merged_with({Rect(kPlaneLabel, 24.5, -0.5, 74.5, 79.5, angled)}), (std::vector<int>{0, 1, 0, 0}));
@@ -122,7 +123,7 @@ TEST(DetectionScore, SaysWhatAMergedPlaneRunsOnto) {
   EXPECT_EQ(merged_with({}), (std::vector<int>{0, 0, 0, 1}));
   // Counted in the summary and the JSON.
   const DetectionScore s = ScoreDetection(Image({plane, Rect(kNonPlaneLabel, 24.5, -0.5, 74.5, 79.5)}), detection);
-  EXPECT_EQ(Summarise({s, s}).merged_with.nonplane, 2);
+  EXPECT_EQ(Summarise({s, s}).unmatched.merged_nonplane, 2);
   EXPECT_EQ(ToJson({s}, {})["summary"]["unmatched"]["merged_with"]["nonplane"], 1);
 }
 

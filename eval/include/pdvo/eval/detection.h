@@ -35,13 +35,13 @@ struct DetectionScoreOptions {
   double match_iou = 0.5;
 };
 
-// Merged reference planes by where most of the detected plane's area outside them lies (see above).
-struct MergedWith {
-  int parallel = 0, angled = 0, nonplane = 0, unannotated = 0;
-  MergedWith& operator+=(const MergedWith& o) {
-    parallel += o.parallel, angled += o.angled, nonplane += o.nonplane, unannotated += o.unannotated;
-    return *this;
-  }
+// Why counted reference planes are not matched within 30 degrees (see above); a merged one by where most of the
+// detected plane's area outside it lies.
+struct Unmatched {
+  int turned = 0, fragmented = 0, missed = 0;
+  int merged_parallel = 0, merged_angled = 0, merged_nonplane = 0, merged_unannotated = 0;
+  int merged() const { return merged_parallel + merged_angled + merged_nonplane + merged_unannotated; }
+  Unmatched& operator+=(const Unmatched& o);
 };
 
 struct DetectionScore {
@@ -53,8 +53,7 @@ struct DetectionScore {
   int matched_10 = 0, matched_30 = 0;     // of them, matched with a normal within 10 / 30 degrees
   std::vector<double> normal_errors_deg;  // of the reference planes matched by IoU (any angle, any size)
   int spurious_planes = 0;                // detected planes that are no reference plane's match
-  int turned = 0, merged = 0, fragmented = 0, missed = 0;  // counted reference planes not matched within 30 degrees
-  MergedWith merged_with;
+  Unmatched unmatched;
   double rand_index = 1, variation_of_information = 0, covering = 1;  // 1, 0, 1 without reference planes
   long segmentation_pixels = 0;  // the reference plane pixels the segmentation figures are over
 };
@@ -72,8 +71,7 @@ struct DetectionSummary {
   double plane_recall_10 = 0, plane_recall_30 = 0;
   double mean_normal_error_deg = 0, median_normal_error_deg = 0;  // over matched planes
   int spurious_planes = 0;
-  int turned = 0, merged = 0, fragmented = 0, missed = 0;
-  MergedWith merged_with;
+  Unmatched unmatched;
   double rand_index = 0, variation_of_information = 0, covering = 0;  // means over images with plane pixels
 };
 DetectionSummary Summarise(const std::vector<DetectionScore>& scores);

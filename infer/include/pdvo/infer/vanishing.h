@@ -82,7 +82,10 @@ struct AzimuthLikelihood {
   std::vector<float> weights;
   double residual_scale = 1;
   bool empty() const { return constraints.empty(); }
-  // For each phi, the weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)): at most 0.
+  // Each edge's robust loss log(1 + (m . d(phi) / scale)^2) for each phi: an edges x phis array.
+  Eigen::ArrayXXf Losses(const std::vector<double>& phis) const;
+  // For each phi, the weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)) (minus the Losses): at
+  // most 0.
   std::vector<double> MeanLogLikelihoods(const std::vector<double>& phis) const;
   // The unit normal of the vertical plane whose horizontal lines run along d(phi), on the side of `towards`.
   Eigen::Vector3d Normal(double phi, const Eigen::Vector3d& towards) const;
