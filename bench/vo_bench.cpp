@@ -245,6 +245,32 @@ int main(int argc, char** argv) {
     plane_pixels[{m.segment, m.plane}].insert(
         {m.keyframe, cvRound(m.keyframe_pixel.x()), cvRound(m.keyframe_pixel.y())});
   }
+  // Where the points off their plane's main surface lie (the purity's complement): on non-planar things or the
+  // sky, on another surface of the same orientation (within 10 degrees: the next facade), on a surface at another
+  // angle (a wall round a corner, the ground), or on a surface while their plane lies mostly on non-planar things;
+  // and how many are within 2% of their depth of the main surface (near the crease where two surfaces meet, no
+  // test of depth can tell them apart).
+  std::array<long, 4> off_kind{};  // non-planar, parallel, angled, in a non-planar plane
+  long off_near = 0;
+  for (const Member& m : members) {
+    const std::optional<int> main = purity.MainLabel(m.frame, m.plane, 4);
+    if (!main) continue;
+    const pdvo::sim::RenderedFrame& g = geometry_of(m.keyframe);
+    const cv::Point at(cvRound(m.keyframe_pixel.x()), cvRound(m.keyframe_pixel.y()));
+    const int id = g.id.at<int>(at);
+    if ((id >= 0 ? street.planes.at(id).surface : -1) == *main) continue;
+    if (*main < 0) {
+      ++off_kind[3];
+      continue;
+    }
+    const pdvo::sim::WorldPlane& surface = street.planes.at(*main);
+    const bool parallel = id >= 0 && surface.normal.dot(street.planes.at(id).normal) > std::cos(10 * M_PI / 180);
+    ++off_kind[id < 0 ? 0 : parallel ? 1 : 2];
+    const float z = g.depth.at<float>(at);
+    if (!(z > 0)) continue;
+    const Eigen::Vector3d world = walk.at(m.keyframe).world_from_cam * (camera.Unproject(m.keyframe_pixel) * z);
+    off_near += std::abs(surface.normal.dot(world) + surface.distance) < 0.02 * z;
+  }
   // Normal error: each plane of min_plane_points or more against the true plane under most of its points, in the
   // camera frame of the keyframe it was last in (the estimated keyframe orientation's error is part of it).
   std::vector<double> normal_errors;
@@ -352,6 +378,12 @@ int main(int argc, char** argv) {
   }
   if (plane_members > 0) {
     std::printf("  plane purity     %.2f of the points of planes on their plane's main true surface\n", pure);
+    std::printf(
+        "  off the surface  %ld of the points: %ld on non-planar things, %ld on a surface of the same orientation, "
+        "%ld at another angle, %ld in planes mostly on non-planar things; %ld of the first three within 2%% of their "
+        "depth of the plane's surface\n",
+        off_kind[0] + off_kind[1] + off_kind[2] + off_kind[3], off_kind[0], off_kind[1], off_kind[2], off_kind[3],
+        off_near);
   }
   std::printf("  planes           %d made, %.1f points per plane, mean area %.0f px\n", mapping.planes,
               mapping.points_per_plane, mapping.mean_plane_area);
@@ -367,16 +399,19 @@ int main(int argc, char** argv) {
         source.c_str(), detected, seeded, extended, dropped, counts.skipped, counts.timed_out, counts.failed);
   }
   // One line for scripts (bench/pdvo_compare.sh): key=value, lists comma-separated.
+  auto share = [&](long count) { return plane_members > 0 ? static_cast<double>(count) / plane_members : -1.0; };
   std::printf(
       "result seed=%llu mode=%s source=%s ate_percent=%.4f tracking_fps=%.1f planes=%d points_per_plane=%.2f "
       "mean_area=%.0f purity=%.4f normal_median=%.2f normal_planes=%zu surfaces=%zu seeded=%d matches_true=%.4f "
-      "matches_gross=%.4f match_median_px=%.3f found_after_one_frame=%.4f curve=",
+      "matches_gross=%.4f match_median_px=%.3f found_after_one_frame=%.4f off_nonplanar=%.4f off_parallel=%.4f "
+      "off_angled=%.4f off_nonplanar_planes=%.4f curve=",
       static_cast<unsigned long long>(seed), pdvo::OptionName(vo_options.mode).c_str(),
       pdvo_mode ? source.c_str() : "none", 100 * ate.translation.rmse / path, frames / cpu_seconds, mapping.planes,
       mapping.points_per_plane, mapping.mean_plane_area, plane_members > 0 ? pure : -1.0,
       normal_errors.empty() ? -1.0 : normal_errors[normal_errors.size() / 2], normal_errors.size(),
       surfaces_mapped.size(), seeded, true_share, gross_share, median_error,
-      searched[0] > 0 ? static_cast<double>(found[0]) / searched[0] : -1.0);
+      searched[0] > 0 ? static_cast<double>(found[0]) / searched[0] : -1.0, share(off_kind[0]), share(off_kind[1]),
+      share(off_kind[2]), share(off_kind[3]));
   for (int a = 0; a < kCurveFrames; ++a) std::printf("%s%.2f", a ? "," : "", curve[a]);
   std::printf(" fps_by_100_frames=");
   for (size_t w = 0; w * 100 < frame_cpu.size(); ++w) {

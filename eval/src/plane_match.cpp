@@ -152,6 +152,20 @@ double PlanePurity::Share(int min_points, long* points) const {
   return all > 0 ? static_cast<double>(on_main) / all : 0.0;
 }
 
+std::optional<int> PlanePurity::MainLabel(int frame, int plane, int min_points) const {
+  const auto group = counts_.find({frame, plane});
+  if (group == counts_.end()) return std::nullopt;
+  int n = 0, most = 0, main = 0;
+  for (const auto& [label, count] : group->second) {
+    n += count;
+    if (count > most) {
+      most = count;
+      main = label;
+    }
+  }
+  return n >= min_points ? std::optional<int>(main) : std::nullopt;
+}
+
 namespace detail {
 
 cv::Size ComparisonSize(const Annotation& reference, const Annotation& estimate, int max_width, const char* what) {

@@ -67,6 +67,10 @@ TEST(PlanePurity, ShareOfPointsOnTheirPlanesMainLabel) {
   EXPECT_DOUBLE_EQ(purity.Share(1), (3.0 + 1.0 + 1.0) / 10.0);
   EXPECT_DOUBLE_EQ(PlanePurity().Share(1, &points), 0.0);
   EXPECT_EQ(points, 0);
+  EXPECT_EQ(purity.MainLabel(0, 1, 4), 7);
+  EXPECT_EQ(purity.MainLabel(0, 2, 4), std::nullopt);  // too few
+  EXPECT_EQ(purity.MainLabel(0, 2, 2), 5);             // a tie: the smallest label
+  EXPECT_EQ(purity.MainLabel(2, 1, 1), std::nullopt);  // no such group
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,6 +57,8 @@ class PlanePurity {
   void Add(int frame, int plane, int label) { ++counts_[{frame, plane}][label]; }
   // 0 if no group is large enough; `points` (optional): how many points the share is over.
   double Share(int min_points, long* points = nullptr) const;
+  // The most common label of group (frame, plane) (the smallest of equals), if it has `min_points` or more.
+  std::optional<int> MainLabel(int frame, int plane, int min_points) const;
 
  private:
   std::map<std::pair<int, int>, std::map<int, int>> counts_;  // (frame, plane) -> label -> points
