@@ -5,8 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <random>
 
 namespace pdvo::vo {
@@ -146,93 +144,6 @@ TEST(Bootstrap, WaitsForTwoFramesThatAgree) {
   ASSERT_TRUE(run.start.has_value()) << "no start after " << run.frame << " frames";
   EXPECT_EQ(run.frame, clean_start + 2);
   EXPECT_GT(run.start->camera.position.normalized().x(), 0.99) << run.start->camera.position.transpose();
-}
-
-}  // namespace
-}  // namespace pdvo::vo
-
-namespace pdvo::vo {
-namespace {
-
-// Normalised image coordinates (z = 1) of the generated pixels, with Gaussian noise of `sigma` px.
-std::vector<Eigen::Vector3d> Normalised(const std::vector<cv::Point2f>& pixels, double sigma, std::mt19937* rng) {
-  std::normal_distribution<double> noise(0, sigma);
-  std::vector<Eigen::Vector3d> out;
-  for (const cv::Point2f& p : pixels) {
-    const Eigen::Vector2d q(p.x + (sigma > 0 ? noise(*rng) : 0), p.y + (sigma > 0 ? noise(*rng) : 0));
-    out.push_back(kCamera.Ray(q) / kCamera.Ray(q).z());
-  }
-  return out;
-}
-double DirectionErrorDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
-}
-
-TEST(RefineRelativeMotion, ConvergesToTheTrueMotionFromAWrongStart) {
-  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(3 * M_PI / 180, Eigen::Vector3d::UnitY())),
-                      Eigen::Vector3d(0.1, 0.02, 1.0));
-  const TwoViews v = Generate(truth, 60, 11);
-  std::mt19937 rng(1);
-  const std::vector<Eigen::Vector3d> first = Normalised(v.first, 0, &rng), second = Normalised(v.second, 0, &rng);
-  // x_second = R x_first + t: the inverse of first_from_second.
-  const Rigid3d second_from_first = truth.Inverse();
-  const Eigen::Matrix3d true_rotation = second_from_first.rotation.toRotationMatrix();
-  const Eigen::Vector3d true_direction = second_from_first.translation.normalized();
-  // Start 2 degrees of turn and about 10 degrees of direction away.
-  Eigen::Matrix3d rotation = ExpSO3(Eigen::Vector3d(0.02, -0.03, 0.01)).toRotationMatrix() * true_rotation;
-  Eigen::Vector3d translation = (true_direction + Eigen::Vector3d(0.15, -0.08, 0)).normalized();
-  ASSERT_GT(DirectionErrorDeg(translation, true_direction), 8);
-  const double ratio = RefineRelativeMotion(first, second, kCamera.fx, 1.0, &rotation, &translation);
-  EXPECT_LT(ratio, 1e-6);
-  EXPECT_LT(LogSO3(Eigen::Quaterniond(rotation.transpose() * true_rotation)).norm() * 180 / M_PI, 1e-4);
-  EXPECT_LT(DirectionErrorDeg(translation, true_direction), 1e-4);
-  EXPECT_NEAR(translation.norm(), 1, 1e-12);
-}
-
-// Nearly forward motion seen by few corners (as a car's first frames at 320 px): RANSAC's motion, fitted to five of
-// them, is what the bootstrap had; fitted to all its inliers the direction is nearer the truth in most trials and
-// on average.
-TEST(RefineRelativeMotion, ImprovesOnRansacsDirection) {
-  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d::UnitY())),
-                      Eigen::Vector3d(-0.02, -0.02, 1.2));
-  const Eigen::Vector3d true_direction = truth.Inverse().translation.normalized();
-  std::mt19937 rng(7);
-  double ransac_sum = 0, refined_sum = 0;
-  int better = 0;
-  constexpr int kTrials = 30;
-  for (int trial = 0; trial < kTrials; ++trial) {
-    const TwoViews v = Generate(truth, 45, 100 + trial, 4, 30);
-    const std::vector<Eigen::Vector3d> first = Normalised(v.first, 0.5, &rng), second = Normalised(v.second, 0.5, &rng);
-    std::vector<cv::Point2f> a, b;
-    for (size_t i = 0; i < first.size(); ++i) {
-      const Eigen::Vector2d p = kCamera.Project(first[i]), q = kCamera.Project(second[i]);
-      a.emplace_back(p.x(), p.y());
-      b.emplace_back(q.x(), q.y());
-    }
-    cv::Mat inliers, r, t;
-    const cv::Mat e = cv::findEssentialMat(a, b, kCamera.K(), cv::RANSAC, 0.999, 1.0, inliers);
-    ASSERT_EQ(e.rows, 3);
-    cv::recoverPose(e, a, b, kCamera.K(), r, t, inliers);
-    Eigen::Matrix3d rotation;
-    Eigen::Vector3d translation;
-    cv::cv2eigen(r, rotation);
-    cv::cv2eigen(t, translation);
-    const double ransac = DirectionErrorDeg(translation, true_direction);
-    std::vector<Eigen::Vector3d> in_first, in_second;
-    for (int i = 0; i < inliers.rows; ++i) {
-      if (!inliers.at<uchar>(i)) continue;
-      in_first.push_back(first[i]);
-      in_second.push_back(second[i]);
-    }
-    EXPECT_LE(RefineRelativeMotion(in_first, in_second, kCamera.fx, 1.0, &rotation, &translation), 1.0);
-    const double refined = DirectionErrorDeg(translation, true_direction);
-    ransac_sum += ransac;
-    refined_sum += refined;
-    better += refined < ransac;
-  }
-  EXPECT_GT(better, kTrials * 2 / 3) << "refined direction nearer the truth in " << better << " of " << kTrials;
-  EXPECT_LT(refined_sum, 0.7 * ransac_sum)
-      << "mean direction error: RANSAC " << ransac_sum / kTrials << " deg, refined " << refined_sum / kTrials << " deg";
 }
 
 }  // namespace

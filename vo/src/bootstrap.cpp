@@ -8,7 +8,6 @@
 #include <opencv2/video/tracking.hpp>
 #include <utility>
 
-#include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
 
@@ -54,78 +53,7 @@ double MedianUnexplainedByRotation(const std::vector<Eigen::Vector3d>& first,
   return Median(angles);
 }
 
-// Sampson distances (px) of the correspondences under x_second = rotation x_first + translation.
-Eigen::VectorXd SampsonDistances(const std::vector<Eigen::Vector3d>& first, const std::vector<Eigen::Vector3d>& second,
-                                 double focal, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation) {
-  const Eigen::Matrix3d e = Hat(translation) * rotation;
-  Eigen::VectorXd r(first.size());
-  for (size_t i = 0; i < first.size(); ++i) {
-    const Eigen::Vector3d ex = e * first[i], etx = e.transpose() * second[i];
-    const double gradient = ex.head<2>().squaredNorm() + etx.head<2>().squaredNorm();
-    r(i) = gradient > 0 ? focal * second[i].dot(ex) / std::sqrt(gradient) : 0;
-  }
-  return r;
-}
-
 }  // namespace
-
-double RefineRelativeMotion(const std::vector<Eigen::Vector3d>& first, const std::vector<Eigen::Vector3d>& second,
-                            double focal, double scale_px, Eigen::Matrix3d* rotation, Eigen::Vector3d* translation) {
-  PDVO_THROW_CHECK(first.size() == second.size() && focal > 0 && scale_px > 0, InvalidArgument,
-                   "RefineRelativeMotion: " << first.size() << " and " << second.size() << " correspondences");
-  Eigen::Matrix3d r = *rotation;
-  Eigen::Vector3d t = translation->normalized();
-  // Moved by delta: a turn (first three) and a step across t (last two, along a basis of its tangent plane).
-  auto moved = [](const Eigen::Matrix3d& r0, const Eigen::Vector3d& t0, const Eigen::Matrix<double, 5, 1>& delta,
-                  Eigen::Matrix3d* r1, Eigen::Vector3d* t1) {
-    const Eigen::Vector3d helper = std::abs(t0.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-    const Eigen::Vector3d u = t0.cross(helper).normalized(), v = t0.cross(u);
-    *r1 = ExpSO3(delta.head<3>()).toRotationMatrix() * r0;
-    *t1 = (t0 + delta(3) * u + delta(4) * v).normalized();
-  };
-  auto cost = [&](const Eigen::VectorXd& d) {  // Cauchy
-    return (d.array() / scale_px).square().log1p().sum();
-  };
-  Eigen::VectorXd d = SampsonDistances(first, second, focal, r, t);
-  const double start = cost(d);
-  double current = start, lambda = 1e-3;
-  for (int iteration = 0; iteration < 20 && lambda < 1e8; ++iteration) {
-    // Cauchy weights, a numerical Jacobian (five columns, central differences).
-    const Eigen::ArrayXd w = 1 / (1 + (d.array() / scale_px).square());
-    Eigen::MatrixXd j(d.size(), 5);
-    for (int k = 0; k < 5; ++k) {
-      Eigen::Matrix<double, 5, 1> step = Eigen::Matrix<double, 5, 1>::Zero();
-      step(k) = 1e-6;
-      Eigen::Matrix3d rp, rm;
-      Eigen::Vector3d tp, tm;
-      moved(r, t, step, &rp, &tp);
-      moved(r, t, -step, &rm, &tm);
-      j.col(k) =
-          (SampsonDistances(first, second, focal, rp, tp) - SampsonDistances(first, second, focal, rm, tm)) / 2e-6;
-    }
-    const Eigen::MatrixXd jw = j.transpose() * w.matrix().asDiagonal();
-    Eigen::Matrix<double, 5, 5> h = jw * j;
-    const Eigen::Matrix<double, 5, 1> g = jw * d;
-    for (; lambda < 1e8; lambda *= 10) {
-      Eigen::Matrix<double, 5, 5> damped = h;
-      damped.diagonal() *= 1 + lambda;
-      const Eigen::Matrix<double, 5, 1> delta = damped.ldlt().solve(-g);
-      Eigen::Matrix3d r1;
-      Eigen::Vector3d t1;
-      moved(r, t, delta, &r1, &t1);
-      const Eigen::VectorXd d1 = SampsonDistances(first, second, focal, r1, t1);
-      if (cost(d1) < current) {
-        const bool converged = current - cost(d1) < 1e-10 * current;
-        r = r1, t = t1, d = d1, current = cost(d1), lambda = std::max(1e-6, lambda / 10);
-        if (converged) iteration = 20;
-        break;
-      }
-    }
-  }
-  *rotation = r;
-  *translation = t;
-  return start > 0 ? current / start : 1;
-}
 
 bool BootstrapOptions::Check() const {
   PDVO_CHECK_OPTION(frames >= 0 && parallax > 0 && velocity_sigma > 0);
@@ -144,20 +72,6 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from,
   // x_second = R x_first + t, |t| = 1.
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation;
-  cv::cv2eigen(r, rotation);
-  cv::cv2eigen(t, translation);
-  // RANSAC's motion fits its minimal sample: refined on all the inliers, then decomposed again for the
-  // triangulation (a car's first frames at 320 px: 8.5 degrees off the true direction before, 1.6 after).
-  std::vector<Eigen::Vector3d> first_normalised, second_normalised;
-  for (int i = 0; i < inliers.rows; ++i) {
-    if (!inliers.at<uchar>(i)) continue;
-    first_normalised.push_back(camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).hnormalized().homogeneous());
-    second_normalised.push_back(camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).hnormalized().homogeneous());
-  }
-  RefineRelativeMotion(first_normalised, second_normalised, camera.fx, kRansacThreshold, &rotation, &translation);
-  cv::Mat refined;
-  cv::eigen2cv(Eigen::Matrix3d(Hat(translation) * rotation), refined);
-  cv::recoverPose(refined, from, to, camera.K(), r, t, kFarthest, inliers, triangulated);
   cv::cv2eigen(r, rotation);
   cv::cv2eigen(t, translation);
   triangulated.convertTo(triangulated, CV_64F);

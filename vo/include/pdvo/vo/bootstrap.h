@@ -67,14 +67,6 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
                      TwoViewMotion* motion);
 
-// The motion x_second = rotation x_first + translation (|translation| = 1) that minimises the robust (Cauchy, scale
-// `scale_px`) sum of the squared Sampson distances (in px of focal length `focal`) of the correspondences `first`,
-// `second` (normalised image coordinates, z = 1), starting from the given one: Levenberg-Marquardt over a turn of
-// the rotation and two directions across the translation. RANSAC's motion is fitted to a minimal sample; this one
-// to all its inliers. Returns the final cost over the starting one.
-double RefineRelativeMotion(const std::vector<Eigen::Vector3d>& first, const std::vector<Eigen::Vector3d>& second,
-                            double focal, double scale_px, Eigen::Matrix3d* rotation, Eigen::Vector3d* translation);
-
 // How far the motion `first_from_second` (the filter's between two keyframes; the length of its translation does
 // not matter) is from what the frames themselves show, as a check of the filter: corners of `first` (at least
 // `border` px inside, `min_distance` px apart) tracked into `second` (8-bit grey; pyramidal Lucas-Kanade), those
