@@ -6,9 +6,11 @@
 # Usage: bench/vo_streets.sh FIRST_SEED LAST_SEED [option=value ...]   e.g. bench/vo_streets.sh 31 42 mode=idpp
 # (seeds 31-42 are the streets the options were tuned on; 1-3 are the benchmark streets of ./run bench)
 # FRAMES=N sets the streets' length (default 1000); synth=sim/config/driving.yaml drives them by car.
+# SIGMAS="0.49 0.5 0.51" runs each street once per search.pixel_sigma listed (an ensemble: a single run per street
+# cannot show a change of the 24-street mean under about 0.1%, docs/developing.md) and averages per street first.
 set -euo pipefail
 if [ $# -lt 2 ]; then
-  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,8p'
+  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,10p'
   exit 2
 fi
 first=$1 last=$2
@@ -17,11 +19,18 @@ bench=${VO_BENCH:-build/bench/vo_bench}
 [ -x "$bench" ] || { echo "vo_streets: $bench not found (./run bench builds it)" >&2; exit 1; }
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+sigmas=(${SIGMAS:-})
 run() {  # core, seeds...
-  local core=$1
+  local core=$1 sigma
   shift
   for seed in "$@"; do
-    taskset -c "$core" "$bench" "${FRAMES:-1000}" "$seed" "${options[@]}" >"$out/$seed.txt"
+    if [ ${#sigmas[@]} -eq 0 ]; then
+      taskset -c "$core" "$bench" "${FRAMES:-1000}" "$seed" "${options[@]}" >"$out/$seed-default.txt"
+    fi
+    for sigma in "${sigmas[@]}"; do
+      taskset -c "$core" "$bench" "${FRAMES:-1000}" "$seed" "${options[@]}" search.pixel_sigma="$sigma" \
+        >"$out/$seed-$sigma.txt"
+    done
   done
 }
 options=("$@")
@@ -34,11 +43,20 @@ run 0 "${even[@]}" &
 run 1 "${odd[@]}"
 wait
 for seed in "${seeds[@]}"; do
-  ate=$(sed -n 's/.*m = \([0-9.]*\)% of the path.*/\1/p' "$out/$seed.txt")
-  [ -n "$ate" ] || { echo "vo_streets: no ATE for seed $seed:" >&2; cat "$out/$seed.txt" >&2; exit 1; }
-  doubt=$(sed -n 's/.*lost \([0-9]*\) times, \([0-9]*\) frames uncertain.*/\1 \2/p' "$out/$seed.txt")
-  echo "$seed $ate $doubt"
-done | awk -v opts="$*" '{ printf "seed %s: %s%%, lost %d, uncertain %d\n", $1, $2, $3, $4; sum += $2; n++;
-    if ($2 > 1) above++; if ($2 > max) max = $2; lost += $3; uncertain += $4 }
-  END { printf "mean %.2f%% over %d streets (max %.2f%%), %d above 1%%; lost %d times, %d frames uncertain [%s]\n",
-    sum / n, n, max, above, lost, uncertain, opts }'
+  for run in "$out/$seed"-*.txt; do
+    ate=$(sed -n 's/^result .* ate_percent=\([0-9.]*\) .*/\1/p' "$run")
+    [ -n "$ate" ] || { echo "vo_streets: no ATE in $(basename "$run" .txt):" >&2; cat "$run" >&2; exit 1; }
+    doubt=$(sed -n 's/.*lost \([0-9]*\) times, \([0-9]*\) frames uncertain.*/\1 \2/p' "$run")
+    echo "$seed $ate $doubt"
+  done
+done | awk -v opts="$*" -v runs="${#sigmas[@]}" '
+  { if (!($1 in ate)) order[++n] = $1; ate[$1] += $2; k[$1]++; lost += $3; uncertain += $4 }
+  END {
+    for (i = 1; i <= n; i++) {
+      s = order[i]; m = ate[s] / k[s]
+      printf "seed %s: %.4f%%%s\n", s, m, (k[s] > 1 ? sprintf(" (mean of %d runs)", k[s]) : "")
+      sum += m; sq += m * m; if (m > 1) above++; if (m > max) max = m
+    }
+    mean = sum / n; se = n > 1 ? sqrt((sq / n - mean * mean) / (n - 1)) : 0
+    printf "mean %.3f%% over %d streets%s (max %.2f%%, standard error over the streets %.3f%%), %d above 1%%; lost %d times, %d frames uncertain [%s]\n",
+      mean, n, (runs > 0 ? sprintf(", %d runs each", runs) : ""), max, se, above, lost, uncertain, opts }'
