@@ -65,8 +65,6 @@ AzimuthTable ColumnAzimuths(const EdgePlanes& edges, const cv::Mat& mask, const 
   for (int i = 0; i < m; ++i) index[column[i]] = i;
   // The mask's edges off the vertical as constraints on phi (AzimuthLikelihood), and each one's column.
   AzimuthLikelihood edges_phi = AzimuthBasis(edges, o);
-  const Eigen::Vector3f up = edges.up.cast<float>(), e1 = edges_phi.e1.cast<float>(), e2 = edges_phi.e2.cast<float>();
-  const float vertical_sin = static_cast<float>(std::sin(o.vertical_band_deg * M_PI / 180));
   std::vector<int> edge_column;
   const cv::Rect box = cv::boundingRect(mask);
   for (int y = box.y; y < box.y + box.height; ++y) {
@@ -75,11 +73,9 @@ AzimuthTable ColumnAzimuths(const EdgePlanes& edges, const cv::Mat& mask, const 
     const float* strength = edges.strength.ptr<float>(y);
     for (int x = box.x; x < box.x + box.width; ++x) {
       if (!in[x] || strength[x] <= 0 || index[x] < 0) continue;
-      const Eigen::Vector3f n(normal[x][0], normal[x][1], normal[x][2]);
-      if (std::abs(n.dot(up)) < vertical_sin) continue;  // a vertical line: says nothing of the azimuth
-      edge_column.push_back(index[x]);
-      edges_phi.constraints.emplace_back(n.dot(e1), n.dot(e2));
-      edges_phi.weights.push_back(strength[x]);
+      if (edges_phi.Add(Eigen::Vector3f(normal[x][0], normal[x][1], normal[x][2]), strength[x])) {
+        edge_column.push_back(index[x]);
+      }
     }
   }
   if (static_cast<int>(edge_column.size()) < o.min_edges) return table;

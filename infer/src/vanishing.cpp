@@ -183,19 +183,21 @@ AzimuthLikelihood AzimuthBasis(const EdgePlanes& edges, const VanishingOptions& 
   l.e1 = (Eigen::Vector3d::UnitX() - edges.up.x() * edges.up).normalized();
   l.e2 = l.e1.cross(edges.up);
   l.residual_scale = o.residual_scale;
+  l.vertical_sin = std::sin(o.vertical_band_deg * kDegree);
   return l;
+}
+
+bool AzimuthLikelihood::Add(const Eigen::Vector3f& m, float strength) {
+  if (std::abs(m.dot(up.cast<float>())) < static_cast<float>(vertical_sin)) return false;
+  constraints.emplace_back(m.dot(e1.cast<float>()), m.dot(e2.cast<float>()));
+  weights.push_back(strength);
+  return true;
 }
 
 AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region, const VanishingOptions& o) {
   AzimuthLikelihood l = AzimuthBasis(edges, o);
   if (!edges.up_found) return l;
-  const Eigen::Vector3f up = edges.up.cast<float>(), e1 = l.e1.cast<float>(), e2 = l.e2.cast<float>();
-  const float vertical_sin = static_cast<float>(std::sin(o.vertical_band_deg * kDegree));
-  ForEachEdge(edges, region, [&](const Eigen::Vector3f& m, float s) {
-    if (std::abs(m.dot(up)) < vertical_sin) return;  // a vertical line: says nothing of the azimuth
-    l.constraints.emplace_back(m.dot(e1), m.dot(e2));
-    l.weights.push_back(s);
-  });
+  ForEachEdge(edges, region, [&](const Eigen::Vector3f& m, float s) { l.Add(m, s); });
   const size_t n = l.constraints.size();
   if (n < static_cast<size_t>(o.min_edges)) {
     l.constraints.clear();

@@ -81,7 +81,11 @@ struct AzimuthLikelihood {
   std::vector<Eigen::Vector2f> constraints;
   std::vector<float> weights;
   double residual_scale = 1;
+  double vertical_sin = 0;  // edges whose plane normal is this near the horizontal lie in the vertical band
   bool empty() const { return constraints.empty(); }
+  // The edge whose plane has normal m (camera frame), with weight `strength`, as a constraint; false, and
+  // nothing added, if it lies in the vertical band (a vertical line says nothing of phi).
+  bool Add(const Eigen::Vector3f& m, float strength);
   // Each edge's robust loss log(1 + (m . d(phi) / scale)^2) for each phi: an edges x phis array.
   Eigen::ArrayXXf Losses(const std::vector<double>& phis) const;
   // For each phi, the weighted mean over edges of log(1 / (1 + (m . d(phi) / scale)^2)) (minus the Losses): at
@@ -94,7 +98,8 @@ struct AzimuthLikelihood {
 };
 AzimuthLikelihood RegionAzimuthLikelihood(const EdgePlanes& edges, const Region& region,
                                           const VanishingOptions& options);
-// Without constraints: the image's vertical, the basis e1, e2 of the horizontal and the residual scale.
+// Without constraints: the image's vertical, the basis e1, e2 of the horizontal, the residual scale and the
+// vertical band.
 AzimuthLikelihood AzimuthBasis(const EdgePlanes& edges, const VanishingOptions& options);
 
 // How much of a region lies on straight edges, a cue to man-made planes: the share of its pixels on coherent
