@@ -159,10 +159,12 @@ PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vect
       probabilities.push_back(windows[static_cast<size_t>(k)].plane_probability);
       normals.push_back(windows[static_cast<size_t>(k)].normal);
     }
-    std::vector<double> sorted = probabilities;
-    std::sort(sorted.begin(), sorted.end());
-    const size_t m = sorted.size();
-    out.planarity[i] = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
+    if (planarity_sigma <= 0) {  // else weighted per point, below
+      std::vector<double> sorted = probabilities;
+      std::sort(sorted.begin(), sorted.end());
+      const size_t m = sorted.size();
+      out.planarity[i] = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
+    }
     out.normals[i] = RobustMeanDirection(normals, probabilities, normal_scale_deg);
   }
   if (planarity_sigma <= 0) return out;
