@@ -50,8 +50,7 @@ Camera Camera::Read(const cv::FileNode& node, const std::string& where) {
   c.cx = ReadNumber(node, "cx", where, true, 0);
   c.cy = ReadNumber(node, "cy", where, true, 0);
   c.depth_scale = ReadNumber(node, "depth_scale", where, false, 0.0);
-  c.readout = ReadNumber(node, "readout", where, false, 0.0);
-  std::set<std::string> known = {"width", "height", "fx", "fy", "cx", "cy", "depth_scale", "readout"};
+  std::set<std::string> known = {"width", "height", "fx", "fy", "cx", "cy", "depth_scale"};
   for (int i = 0; i < 5; ++i) {
     c.distortion[i] = ReadNumber(node, kDistortionKeys[i], where, false, 0.0);
     known.insert(kDistortionKeys[i]);
@@ -77,7 +76,6 @@ void Camera::Write(cv::FileStorage& fs) const {
      << "width" << width << "height" << height << "fx" << fx << "fy" << fy << "cx" << cx << "cy" << cy;
   for (int i = 0; i < 5; ++i) fs << kDistortionKeys[i] << distortion[i];
   if (depth_scale > 0) fs << "depth_scale" << depth_scale;
-  if (readout > 0) fs << "readout" << readout;
   fs << "}";
 }
 
@@ -88,8 +86,6 @@ void Camera::Check(const std::string& where) const {
                    where << ": focal lengths must be positive and finite, got fx=" << fx << " fy=" << fy);
   PDVO_THROW_CHECK(std::isfinite(depth_scale) && depth_scale >= 0, InvalidArgument,
                    where << ": depth_scale must be positive, got " << depth_scale);
-  PDVO_THROW_CHECK(std::isfinite(readout) && readout >= 0 && readout < 1, InvalidArgument,
-                   where << ": readout must be from 0 to 1 s, got " << readout);
   PDVO_THROW_CHECK(std::isfinite(cx) && std::isfinite(cy), InvalidArgument, where << ": principal point is not finite");
   for (int i = 0; i < 5; ++i) {
     PDVO_THROW_CHECK(std::isfinite(distortion[i]), InvalidArgument,

@@ -24,28 +24,6 @@ TEST(Camera, YamlRoundTrip) {
   EXPECT_EQ(Camera::Read(dir / "camera.yaml"), c);
 }
 
-TEST(Camera, RollingShutterReadoutRoundTripsAndTimesRows) {
-  test::TempDir dir;
-  WriteFileAtomically(dir / "c.yaml",
-                      "%YAML:1.0\nwidth: 320\nheight: 240\nfx: 300\nfy: 301\ncx: 160\ncy: 120\nreadout: 0.024\n");
-  const Camera c = Camera::Read(dir / "c.yaml");
-  EXPECT_DOUBLE_EQ(c.readout, 0.024);
-  c.Write(dir / "d.yaml");
-  EXPECT_EQ(Camera::Read(dir / "d.yaml"), c);
-  EXPECT_DOUBLE_EQ(c.Rescaled(640, 480).readout, 0.024);  // the same rows, read in the same time
-  // The top edge read first, the bottom edge last; the middle of the image at time 0.
-  EXPECT_DOUBLE_EQ(c.RowTime(-0.5), -0.012);
-  EXPECT_DOUBLE_EQ(c.RowTime(239.5), 0.012);
-  EXPECT_DOUBLE_EQ(c.RowTime(119.5), 0);
-  EXPECT_EQ(TumFr1().RowTime(0), TumFr1().readout * (0.5 / 480 - 0.5));
-  for (const char* bad : {"-0.01", "2", ".nan"}) {
-    WriteFileAtomically(dir / "e.yaml", std::string("%YAML:1.0\nwidth: 320\nheight: 240\nfx: 3\nfy: 3\ncx: 1\ncy: 1\n"
-                                                    "readout: ") +
-                                            bad + "\n");
-    EXPECT_THROW(Camera::Read(dir / "e.yaml"), FormatError) << bad;
-  }
-}
-
 TEST(Camera, ReadsARootMapWithoutDistortion) {
   test::TempDir dir;
   WriteFileAtomically(dir / "c.yaml", "%YAML:1.0\nwidth: 320\nheight: 240\nfx: 300\nfy: 301\ncx: 160\ncy: 120\n");

@@ -51,56 +51,6 @@ TEST(Filter, PlanePointJacobianMatchesCentralDifferencesOverTheWholeState) {
   }
 }
 
-// A rolling shutter: a measurement's pixel depends on the camera's velocities (it was read before or after
-// the middle row); the Jacobian of the measured row's prediction over the whole state against central differences.
-TEST(Filter, RollingShutterJacobianMatchesCentralDifferencesOverTheWholeState) {
-  Camera rolling = kCamera;
-  rolling.readout = 0.03;
-  const Filter f = BusyFilter();
-  const int plane = f.planes().begin()->first;
-  std::vector<PointMeasurement> measurements;
-  for (const auto& [id, point] : f.points()) measurements.push_back({id, {0, 30.0 + 40 * id}});
-  measurements.push_back({plane, {0, 200}, 1, kCamera.Ray({220, 170})});
-  for (const PointMeasurement& z : measurements) {
-    Eigen::Vector2d pixel;
-    MeasurementJacobian sparse;
-    ASSERT_TRUE(f.PredictMeasurement(rolling, z, &pixel, &sparse));
-    EXPECT_TRUE(sparse.rolling);
-    const Eigen::MatrixXd j = sparse.Dense(f.size());
-    const Eigen::MatrixXd numeric = NumericJacobian(f, [&](const Filter& g) {
-      Eigen::Vector2d p;
-      EXPECT_TRUE(g.PredictMeasurement(rolling, z, &p, nullptr));
-      return p;
-    });
-    EXPECT_LT((j - numeric).cwiseAbs().maxCoeff(), 1e-5) << "feature " << z.point;
-    EXPECT_GT(j.middleCols<6>(6).norm(), 0.001) << "the velocities move the pixel";
-    // The sparse products with the velocity block.
-    const Eigen::MatrixXd& p = f.covariance();
-    EXPECT_LT((sparse.CovarianceTimesTranspose(p) - p * j.transpose()).cwiseAbs().maxCoeff(), 1e-12);
-    EXPECT_LT((sparse.Propagate(p) - j * p * j.transpose()).cwiseAbs().maxCoeff(), 1e-12);
-    const Eigen::MatrixXd x = Eigen::MatrixXd::Random(f.size(), 3);
-    EXPECT_LT((sparse.Times(x) - j * x).cwiseAbs().maxCoeff(), 1e-12);
-  }
-}
-
-// Without a measurement the prediction is where the camera, moving, was when it read the predicted row.
-TEST(Filter, RollingShutterPredictionIsWhereTheCameraWasWhenItReadThatRow) {
-  Camera rolling = kCamera;
-  rolling.readout = 0.03;
-  const Filter f = BusyFilter();
-  for (const auto& [id, point] : f.points()) {
-    Eigen::Vector2d global, pixel;
-    ASSERT_TRUE(f.PredictPoint(kCamera, id, &global, nullptr));
-    ASSERT_TRUE(f.PredictPoint(rolling, id, &pixel, nullptr));
-    const Rigid3d& ref = f.references().at(point.reference).world_from_cam;
-    const Eigen::Vector3d x = ref * Eigen::Vector3d(point.ray / point.inverse_depth);
-    const Rigid3d at_row = PoseAfter(f.camera(), rolling.RowTime(pixel.y()));
-    EXPECT_LT((rolling.Project(at_row.Inverse() * x) - pixel).norm(), 0.01) << "point " << id;
-    // The camera turns at 0.3 rad/s: rows 100 px from the middle are read 12 ms off, 1 px away.
-    EXPECT_NEAR((pixel - global).norm(), std::abs(rolling.RowTime(global.y())) * 0.3 * 277, 0.3) << "point " << id;
-  }
-}
-
 TEST(Filter, ReferenceCopiesTheCameraPoseAndItsUncertainty) {
   CameraState c;
   c.position = Eigen::Vector3d(1, 2, 3);

@@ -71,35 +71,6 @@ TEST(Motion, ConstantVelocityFollowsTheClosedForm) {
   EXPECT_EQ(s.angular_velocity, start.angular_velocity);
 }
 
-TEST(Motion, PoseAfterIsTheConstantVelocityPoseAndItsJacobianMatchesCentralDifferences) {
-  std::mt19937 rng(5);
-  const double eps = 1e-6;
-  for (const double tau : {-0.015, 0.004, 0.02}) {
-    const CameraState s = RandomState(rng);
-    Eigen::Matrix<double, 6, 12> j;
-    const Rigid3d pose = PoseAfter(s, tau, &j);
-    const CameraState moved = PredictCamera(s, tau);  // the same motion, for tau > 0 and tau < 0 alike
-    EXPECT_LT((pose.translation - moved.position).norm(), 1e-12);
-    EXPECT_LT(AngularDistance(pose.rotation, moved.orientation), 1e-12);
-    // The pose's error (dp, dtheta on the right) for a change of the state's error.
-    const auto error = [&](const Rigid3d& other) {
-      Eigen::Matrix<double, 6, 1> e;
-      e << other.translation - pose.translation, LogSO3(pose.rotation.conjugate() * other.rotation);
-      return e;
-    };
-    Eigen::Matrix<double, 6, 12> numeric;
-    for (int i = 0; i < 12; ++i) {
-      const Vector12d e = eps * Vector12d::Unit(i);
-      numeric.col(i) = (error(PoseAfter(s.Plus(e), tau)) - error(PoseAfter(s.Plus(-e), tau))) / (2 * eps);
-    }
-    EXPECT_LT((j - numeric).cwiseAbs().maxCoeff(), 1e-7) << "tau " << tau << "\n" << j << "\n" << numeric;
-  }
-  Eigen::Matrix<double, 6, 12> j;
-  PoseAfter(RandomState(rng), 0, &j);
-  EXPECT_EQ(j.leftCols<6>(), (Eigen::Matrix<double, 6, 6>::Identity()));
-  EXPECT_TRUE(j.rightCols<6>().isZero());  // no time, no velocity in it
-}
-
 TEST(Motion, ProcessNoiseIsSymmetricPositiveSemidefiniteAndScales) {
   std::mt19937 rng(4);
   Eigen::Matrix<double, 12, 6> g;

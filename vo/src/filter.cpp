@@ -22,37 +22,28 @@ const char* ToString(UpdateStatus status) {
 Eigen::MatrixXd MeasurementJacobian::Dense(int size) const {
   Eigen::MatrixXd j = Eigen::MatrixXd::Zero(2, size);
   j.leftCols<6>() = camera;
-  if (rolling) j.middleCols<6>(6) = velocity;
   j.middleCols<6>(reference_offset) += reference;
   j.middleCols(feature_offset, feature_size) += feature.leftCols(feature_size);
   return j;
 }
 
 Eigen::Matrix<double, Eigen::Dynamic, 2> MeasurementJacobian::CovarianceTimesTranspose(const Eigen::MatrixXd& p) const {
-  Eigen::Matrix<double, Eigen::Dynamic, 2> out =
-      p.leftCols<6>() * camera.transpose() + p.middleCols<6>(reference_offset) * reference.transpose() +
-      p.middleCols(feature_offset, feature_size) * feature.leftCols(feature_size).transpose();
-  if (rolling) out += p.middleCols<6>(6) * velocity.transpose();
-  return out;
+  return p.leftCols<6>() * camera.transpose() + p.middleCols<6>(reference_offset) * reference.transpose() +
+         p.middleCols(feature_offset, feature_size) * feature.leftCols(feature_size).transpose();
 }
 
 Eigen::Matrix<double, 2, Eigen::Dynamic> MeasurementJacobian::Times(const Eigen::MatrixXd& x) const {
-  Eigen::Matrix<double, 2, Eigen::Dynamic> out =
-      camera * x.topRows<6>() + reference * x.middleRows<6>(reference_offset) +
-      feature.leftCols(feature_size) * x.middleRows(feature_offset, feature_size);
-  if (rolling) out += velocity * x.middleRows<6>(6);
-  return out;
+  return camera * x.topRows<6>() + reference * x.middleRows<6>(reference_offset) +
+         feature.leftCols(feature_size) * x.middleRows(feature_offset, feature_size);
 }
 
 Eigen::Matrix2d MeasurementJacobian::Propagate(const Eigen::MatrixXd& p) const {
-  // The blocks of P that the column blocks meet: nine (sixteen with velocities) small products.
-  const int n = rolling ? 4 : 3;
-  const int offsets[4] = {0, reference_offset, feature_offset, 6}, sizes[4] = {6, 6, feature_size, 6};
-  const Eigen::Matrix<double, 2, Eigen::Dynamic> blocks[4] = {camera, reference, feature.leftCols(feature_size),
-                                                              velocity};
+  // The blocks of P that the three column blocks meet: nine small products.
+  const int offsets[3] = {0, reference_offset, feature_offset}, sizes[3] = {6, 6, feature_size};
+  const Eigen::Matrix<double, 2, Eigen::Dynamic> blocks[3] = {camera, reference, feature.leftCols(feature_size)};
   Eigen::Matrix2d out = Eigen::Matrix2d::Zero();
-  for (int a = 0; a < n; ++a) {
-    for (int b = 0; b < n; ++b) {
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
       out += blocks[a] * p.block(offsets[a], offsets[b], sizes[a], sizes[b]) * blocks[b].transpose();
     }
   }
@@ -271,72 +262,49 @@ void Filter::Renumber() {
 }
 
 bool Filter::PredictPoint(const Camera& camera, int id, Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const {
-  PDVO_THROW_CHECK(points_.count(id), InvalidArgument, "filter: no point " << id);
-  return Predict(camera, id, Eigen::Vector3d::Zero(), nullptr, pixel, jacobian);
+  const Point& p = points_.at(id);
+  const Reference& r = references_.at(p.reference);
+  ProjectionJacobians j;
+  if (!ProjectInverseDepth(camera, camera_.world_from_cam(), r.world_from_cam, p.ray, p.inverse_depth, pixel,
+                           jacobian ? &j : nullptr)) {
+    return false;
+  }
+  if (jacobian) {
+    jacobian->camera = j.current;
+    jacobian->reference = j.reference;
+    jacobian->feature.col(0) = j.inverse_depth;
+    jacobian->reference_offset = r.offset;
+    jacobian->feature_offset = p.offset;
+    jacobian->feature_size = 1;
+  }
+  return true;
 }
 
 bool Filter::PredictPlanePoint(const Camera& camera, int id, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
                                MeasurementJacobian* jacobian) const {
-  PDVO_THROW_CHECK(planes_.count(id), InvalidArgument, "filter: no plane " << id);
-  return Predict(camera, id, ray, nullptr, pixel, jacobian);
+  const Plane& p = planes_.at(id);
+  const Reference& r = references_.at(p.reference);
+  ProjectionJacobians j;
+  Eigen::Matrix<double, 2, 4> jp;
+  if (!ProjectPlanePoint(camera, camera_.world_from_cam(), r.world_from_cam, p.plane, ray, pixel,
+                         jacobian ? &j : nullptr, jacobian ? &jp : nullptr)) {
+    return false;
+  }
+  if (jacobian) {
+    jacobian->camera = j.current;
+    jacobian->reference = j.reference;
+    jacobian->feature = jp;
+    jacobian->reference_offset = r.offset;
+    jacobian->feature_offset = p.offset;
+    jacobian->feature_size = 4;
+  }
+  return true;
 }
 
 bool Filter::PredictMeasurement(const Camera& camera, const PointMeasurement& z, Eigen::Vector2d* pixel,
                                 MeasurementJacobian* jacobian) const {
-  return Predict(camera, z.point, z.ray, &z.pixel.y(), pixel, jacobian);
-}
-
-bool Filter::Predict(const Camera& camera, int id, const Eigen::Vector3d& ray, const double* row,
-                     Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const {
-  const auto plane = planes_.find(id);
-  const Point* point = plane == planes_.end() ? &points_.at(id) : nullptr;
-  const int reference = point ? point->reference : plane->second.reference;
-  const Reference& r = references_.at(reference);
-  ProjectionJacobians j;
-  Eigen::Matrix<double, 2, 4> jp;
-  const auto project = [&](const Rigid3d& world_from_current, bool with_jacobians) {
-    ProjectionJacobians* pj = with_jacobians ? &j : nullptr;
-    return point ? ProjectInverseDepth(camera, world_from_current, r.world_from_cam, point->ray, point->inverse_depth,
-                                       pixel, pj)
-                 : ProjectPlanePoint(camera, world_from_current, r.world_from_cam, plane->second.plane, ray, pixel, pj,
-                                     with_jacobians ? &jp : nullptr);
-  };
-  Rigid3d pose = camera_.world_from_cam();
-  Eigen::Matrix<double, 6, 12> pose_jacobian;
-  const bool rolling = camera.readout > 0;
-  if (rolling) {
-    if (row) {
-      pose = PoseAfter(camera_, camera.RowTime(*row), &pose_jacobian);
-    } else {  // the row at which it is predicted, twice (the second moves it by a small share of a pixel)
-      for (int pass = 0; pass < 2; ++pass) {
-        if (!project(pose, false)) return false;
-        pose = PoseAfter(camera_, camera.RowTime(pixel->y()), &pose_jacobian);
-      }
-    }
-  }
-  if (!project(pose, jacobian != nullptr)) return false;
-  if (jacobian) {
-    jacobian->rolling = rolling;
-    if (rolling) {
-      const Eigen::Matrix<double, 2, 12> c = j.current * pose_jacobian;
-      jacobian->camera = c.leftCols<6>();
-      jacobian->velocity = c.rightCols<6>();
-    } else {
-      jacobian->camera = j.current;
-    }
-    jacobian->reference = j.reference;
-    jacobian->reference_offset = r.offset;
-    if (point) {
-      jacobian->feature.col(0) = j.inverse_depth;
-      jacobian->feature_offset = point->offset;
-      jacobian->feature_size = 1;
-    } else {
-      jacobian->feature = jp;
-      jacobian->feature_offset = plane->second.offset;
-      jacobian->feature_size = 4;
-    }
-  }
-  return true;
+  return planes_.count(z.point) ? PredictPlanePoint(camera, z.point, z.ray, pixel, jacobian)
+                                : PredictPoint(camera, z.point, pixel, jacobian);
 }
 
 UpdateStatus Filter::Linearise(const Camera& camera, const std::vector<PointMeasurement>& measurements,
@@ -415,8 +383,7 @@ void Filter::PredictAfter(const Camera& camera, const std::vector<PointMeasureme
                           std::vector<bool>* predicted) const {
   PDVO_THROW_CHECK(step.size() == size(), InvalidArgument, "filter: a step of the wrong size");
   // The moved camera and reference cameras, computed as Apply computes them.
-  const CameraState moved_camera = camera_.Plus(step.head<12>());
-  const Rigid3d middle = moved_camera.world_from_cam();
+  const Rigid3d current = camera_.Plus(step.head<12>()).world_from_cam();
   std::map<int, Rigid3d> references;
   for (const auto& [id, r] : references_) {
     references[id] = Rigid3d(r.world_from_cam.rotation * ExpSO3(step.segment<3>(r.offset + 3)),
@@ -427,7 +394,6 @@ void Filter::PredictAfter(const Camera& camera, const std::vector<PointMeasureme
   for (size_t k = 0; k < measurements.size(); ++k) {
     const PointMeasurement& z = measurements[k];
     Eigen::Vector2d& pixel = (*pixels)[k];
-    const Rigid3d current = camera.readout > 0 ? PoseAfter(moved_camera, camera.RowTime(z.pixel.y())) : middle;
     if (const auto plane = planes_.find(z.point); plane != planes_.end()) {
       const Plane& p = plane->second;
       InversePlane moved = p.plane;

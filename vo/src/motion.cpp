@@ -52,18 +52,6 @@ CameraState PredictCamera(const CameraState& s, double dt, Matrix12d* f, Eigen::
   return out;
 }
 
-Rigid3d PoseAfter(const CameraState& s, double tau, Eigen::Matrix<double, 6, 12>* jacobian) {
-  const Eigen::Vector3d turn = s.angular_velocity * tau;
-  if (jacobian) {
-    jacobian->setZero();
-    jacobian->block<3, 3>(0, 0).setIdentity();
-    jacobian->block<3, 3>(0, 6) = tau * Eigen::Matrix3d::Identity();
-    jacobian->block<3, 3>(3, 3) = ExpSO3(turn).toRotationMatrix().transpose();
-    jacobian->block<3, 3>(3, 9) = tau * RightJacobianSO3(turn);
-  }
-  return Rigid3d((s.orientation * ExpSO3(turn)).normalized(), s.position + s.velocity * tau);
-}
-
 Matrix12d ProcessNoise(const Eigen::Matrix<double, 12, 6>& g, double dt, double linear_acceleration,
                        double angular_acceleration) {
   Eigen::Matrix<double, 6, 1> variances;

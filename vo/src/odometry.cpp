@@ -353,7 +353,6 @@ struct Odometry::Impl {
     keyframe.grey = grey.clone();
     keyframe.time = timestamp;
     keyframe.frame = static_cast<int>(trajectory.size());
-    keyframe.angular_velocity = filter->camera().angular_velocity;
     for (const cv::Point2f& c : found) keyframe.corners.push_back({Eigen::Vector2d(c.x, c.y), false});
     const std::vector<PlaneSeed> seeds = seeder ? seeder->Seed(keyframe, camera) : std::vector<PlaneSeed>();
     for (const PlaneSeed& seed : seeds) {
@@ -361,7 +360,7 @@ struct Odometry::Impl {
       corner.used = true;
       const double rho = PriorInverseDepth(known, corner.pixel);
       const int id = filter->AddPlane(reference, {seed.normal, rho}, seed.sigma_normal, PriorSigma(rho));
-      tracks.planes[id].members.push_back({corner.pixel, keyframe.Ray(camera, corner.pixel), {}});
+      tracks.planes[id].members.push_back({corner.pixel, camera.Ray(corner.pixel), {}});
     }
     // Points: the strongest corners left (goodFeaturesToTrack sorts by strength).
     std::vector<Filter::NewPoint> points;
@@ -370,7 +369,7 @@ struct Odometry::Impl {
       if (c.used || static_cast<int>(points.size() + seeds.size()) >= new_features) continue;
       c.used = true;
       const double rho = PriorInverseDepth(known, c.pixel);
-      points.push_back({keyframe.Ray(camera, c.pixel), rho, PriorSigma(rho)});
+      points.push_back({camera.Ray(c.pixel), rho, PriorSigma(rho)});
       pixels.push_back(c.pixel);
     }
     const std::vector<int> ids = filter->AddPoints(reference, points);
@@ -440,12 +439,11 @@ std::vector<Odometry::PlaneOutline> Odometry::plane_outlines() const {
   for (const auto& [id, track] : impl_->tracks.planes) {
     const Filter::Plane& plane = f.planes().at(id);
     const Rigid3d cam_from_ref = cam_from_world * f.references().at(plane.reference).world_from_cam;
-    const Keyframe& keyframe = impl_->tracks.keyframes.at(plane.reference);
     // Keyframe pixels through the plane into the current frame.
     auto carry = [&](const std::vector<Eigen::Vector2d>& pixels) {
       std::vector<Eigen::Vector2d> seen;
       for (const Eigen::Vector2d& q : pixels) {
-        const Eigen::Vector3d ray = keyframe.Ray(camera, q);
+        const Eigen::Vector3d ray = camera.Ray(q);
         const double rho = plane.plane.InverseDepthAlong(ray);
         if (rho <= 0) continue;
         const Eigen::Vector3d x = cam_from_ref * (ray / rho);

@@ -89,8 +89,7 @@ void PlaneGrower::Grow(Filter* filter, Tracks* tracks, MapRecord* record) const 
 void PlaneGrower::AddCandidates(int id, Filter* filter, Tracks* tracks) const {
   const Filter::Plane& plane = filter->planes().at(id);
   PlaneTrack& t = tracks->planes.at(id);
-  Keyframe& keyframe = tracks->keyframes.at(plane.reference);
-  std::vector<Corner>& corners = keyframe.corners;
+  std::vector<Corner>& corners = tracks->keyframes.at(plane.reference).corners;
   const int wanted = t.detected ? detected_.new_points : o_.new_plane_points;
   const size_t count = t.detected ? t.region_corners.size() : corners.size();
   int added = 0;
@@ -100,7 +99,7 @@ void PlaneGrower::AddCandidates(int id, Filter* filter, Tracks* tracks) const {
     double nearest = 1e9;
     for (const PlanePoint& m : t.members) nearest = std::min(nearest, (m.keyframe_pixel - corner.pixel).norm());
     if ((!t.detected && nearest > o_.grow_radius) || nearest < features_.min_distance) continue;
-    const Eigen::Vector3d ray = keyframe.Ray(camera_, corner.pixel);
+    const Eigen::Vector3d ray = camera_.Ray(corner.pixel);
     const double rho = plane.plane.InverseDepthAlong(ray);
     if (rho <= 0) continue;
     corner.used = true;

@@ -290,7 +290,7 @@ SeedingOutcome SeedDetectedPlanes(const std::vector<DetectedPlane>& planes, int 
       ++out.no_corner;
       continue;
     }
-    const Eigen::Vector3d ray = keyframe.Ray(camera, seed->pixel);
+    const Eigen::Vector3d ray = camera.Ray(seed->pixel);
     if (n.dot(ray) > -o.min_facing) {
       ++out.grazing;
       continue;

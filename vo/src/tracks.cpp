@@ -15,12 +15,6 @@ bool FeatureOptions::Check() const {
   return true;
 }
 
-Eigen::Vector3d Keyframe::Ray(const Camera& camera, const Eigen::Vector2d& pixel) const {
-  const Eigen::Vector3d ray = camera.Ray(pixel);
-  if (camera.readout == 0) return ray;
-  return ExpSO3(angular_velocity * camera.RowTime(pixel.y())) * ray;
-}
-
 bool Inside(const Eigen::Vector2d& p, const cv::Size& size, int border) {
   return p.x() >= border && p.y() >= border && p.x() < size.width - border && p.y() < size.height - border;
 }

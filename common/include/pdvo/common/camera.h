@@ -5,7 +5,6 @@
 //   width: 640   height: 480   fx: 517.3   fy: 516.5   cx: 318.6   cy: 255.3
 //   k1: 0.2624   k2: -0.9531   p1: -0.0054   p2: 0.0026   k3: 1.1633     # optional, default 0
 //   depth_scale: 5000   # optional: an RGB-D camera's depth image units per metre
-//   readout: 0.03       # optional: a rolling shutter's time (s) from the top row to the bottom one; 0: global
 // Width, height, fx, fy, cx and cy are required; any other key is an error.
 #pragma once
 
@@ -27,7 +26,6 @@ struct Camera {
   double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
   std::array<double, 5> distortion{};     // k1, k2, p1, p2, k3
   double depth_scale = 0;                 // depth image units per metre; 0: not given
-  double readout = 0;                     // s from reading the top row to the bottom one; 0: a global shutter
 
   // Reads from YAML; throws IoError / FormatError naming the file and the missing or bad key.
   static Camera Read(const std::string& path);
@@ -39,9 +37,6 @@ struct Camera {
   void Check(const std::string& where) const;
 
   bool HasDistortion() const;
-  // When row `y` (pixels) was read, in seconds after the middle of the image was (rolling shutter; 0 for a
-  // global one): readout ((y + 1/2) / height - 1/2).
-  double RowTime(double y) const { return readout * ((y + 0.5) / height - 0.5); }
   cv::Matx33d K() const;
 
   // Projects a point in camera coordinates (z > 0) to distorted pixel coordinates.

@@ -42,14 +42,11 @@ struct PointMeasurement {
 };
 
 // A measurement's Jacobian with respect to the error state (2 x Filter::size()), kept as its only non-zero
-// blocks: the current camera's pose (columns 0-5), with a rolling shutter its velocities too (columns 6-11:
-// the row was read before or after the middle one), the feature's reference camera (6 columns at its offset) and
+// blocks: the current camera's pose (columns 0-5), the feature's reference camera (6 columns at its offset) and
 // the feature itself (a point's inverse depth: 1 column; a plane: 4). Products with the covariance then cost
 // O(size) instead of O(size^2).
 struct MeasurementJacobian {
   Eigen::Matrix<double, 2, 6> camera = Eigen::Matrix<double, 2, 6>::Zero();
-  Eigen::Matrix<double, 2, 6> velocity = Eigen::Matrix<double, 2, 6>::Zero();  // used if rolling
-  bool rolling = false;
   Eigen::Matrix<double, 2, 6> reference = Eigen::Matrix<double, 2, 6>::Zero();
   Eigen::Matrix<double, 2, 4> feature = Eigen::Matrix<double, 2, 4>::Zero();  // its first feature_size columns
   int reference_offset = 0, feature_offset = 0, feature_size = 1;
@@ -135,9 +132,7 @@ class Filter {
   InversePlane PlaneSeenFrom(int plane, int reference, Eigen::Matrix4d* jacobian = nullptr) const;
 
   // The predicted pixel of a point and its Jacobian with respect to the whole error state (2 x size()); false
-  // if the point is behind the camera. With a rolling shutter (Camera::readout), the camera is where it was
-  // when it read the predicted pixel's row (PoseAfter, Camera::RowTime); a measurement (PredictMeasurement), when
-  // it read the measured pixel's row.
+  // if the point is behind the camera.
   bool PredictPoint(const Camera& camera, int point, Eigen::Vector2d* pixel, MeasurementJacobian* jacobian) const;
   // The same for the point of a plane on `ray`; false also if the ray does not meet the plane in front.
   bool PredictPlanePoint(const Camera& camera, int plane, const Eigen::Vector3d& ray, Eigen::Vector2d* pixel,
@@ -181,10 +176,6 @@ class Filter {
   static UpdateStatus ComputeGain(Eigen::MatrixXd ph_t, const Eigen::MatrixXd& s, Gain* gain);
   // The EKF correction: the state moves by K innovation and P becomes P - K H P.
   UpdateResult Correct(const Gain& gain, const Eigen::VectorXd& innovation);
-  // PredictPoint and PredictPlanePoint (ray used for planes only), at the pose of the given row or, without
-  // one, of the predicted pixel's row.
-  bool Predict(const Camera& camera, int feature, const Eigen::Vector3d& ray, const double* row, Eigen::Vector2d* pixel,
-               MeasurementJacobian* jacobian) const;
   // Drops the error-state indices `dropped` and, of `references` (one entry per removed feature), those left
   // without users.
   void Remove(std::vector<int> dropped, const std::vector<int>& references);

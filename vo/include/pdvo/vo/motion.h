@@ -60,11 +60,6 @@ struct CameraState {
 CameraState PredictCamera(const CameraState& state, double dt, Matrix12d* f = nullptr,
                           Eigen::Matrix<double, 12, 6>* g = nullptr);
 
-// The camera's pose tau seconds after the state's time, at its constant velocity: p + v tau, q Exp(w tau) (the
-// pose at which a rolling shutter read a row, Camera::RowTime). `jacobian` (6x12): of that pose's error (dp,
-// dtheta) with respect to the state's error (dp, dtheta, dv, dw): [I 0 tau I 0; 0 Exp(w tau)^T 0 tau Jr(w tau)].
-Rigid3d PoseAfter(const CameraState& state, double tau, Eigen::Matrix<double, 6, 12>* jacobian = nullptr);
-
 // The process noise of a step: g diag(sigma_a^2 dt^2 I, sigma_alpha^2 dt^2 I) g^T, with accelerations in
 // m/s^2 and rad/s^2 (standard deviations).
 Matrix12d ProcessNoise(const Eigen::Matrix<double, 12, 6>& g, double dt, double linear_acceleration,

@@ -81,12 +81,6 @@ struct Keyframe {
   double time = 0;
   int frame = -1;  // its index in the frames tracked
   std::vector<Corner> corners;
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // the camera's (rad/s, its frame) when it was made
-
-  // The ray (unit) of a pixel in the reference camera's frame, the camera as it was at the middle row's time: a
-  // rolling shutter's turn (Camera::readout) between the pixel's row and that one undone. Its translation, which
-  // would need the depth, is not (up to two centimetres at the top and bottom rows when walking).
-  Eigen::Vector3d Ray(const Camera& camera, const Eigen::Vector2d& pixel) const;
 };
 
 // How a feature's searches have fared.
