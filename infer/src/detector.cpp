@@ -114,7 +114,7 @@ std::vector<std::vector<int>> Components(int n, const std::vector<std::pair<int,
 }  // namespace
 
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
-                         double normal_scale_deg, double planarity_sigma) {
+                         double normal_scale_deg) {
   const size_t n = points.size();
   // The windows' edges cut the image into rectangles whose pixels all lie in the same windows: a point's windows
   // are found once per rectangle, and points held by the same windows (most share a cell) are pooled once.
@@ -159,38 +159,11 @@ PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vect
       probabilities.push_back(windows[static_cast<size_t>(k)].plane_probability);
       normals.push_back(windows[static_cast<size_t>(k)].normal);
     }
-    if (planarity_sigma <= 0) {  // else weighted per point, below
-      std::vector<double> sorted = probabilities;
-      std::sort(sorted.begin(), sorted.end());
-      const size_t m = sorted.size();
-      out.planarity[i] = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
-    }
+    std::vector<double> sorted = probabilities;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t m = sorted.size();
+    out.planarity[i] = m % 2 ? sorted[m / 2] : 0.5 * (sorted[m / 2 - 1] + sorted[m / 2]);
     out.normals[i] = RobustMeanDirection(normals, probabilities, normal_scale_deg);
-  }
-  if (planarity_sigma <= 0) return out;
-  // Weighted by where the point lies in each window: pooled per point (the lower weighted median).
-  std::vector<std::pair<double, double>> weighted;  // probability, weight
-  for (size_t i = 0; i < n; ++i) {
-    if (holding[i]->empty()) continue;
-    weighted.clear();
-    double total = 0;
-    for (const int k : *holding[i]) {
-      const DetectedWindow& w = windows[static_cast<size_t>(k)];
-      const double dx = (points[i].x - (w.box.x + 0.5 * w.box.width)) / (0.5 * w.box.width);
-      const double dy = (points[i].y - (w.box.y + 0.5 * w.box.height)) / (0.5 * w.box.height);
-      weighted.emplace_back(w.plane_probability,
-                            std::exp(-0.5 * (dx * dx + dy * dy) / (planarity_sigma * planarity_sigma)));
-      total += weighted.back().second;
-    }
-    std::sort(weighted.begin(), weighted.end());
-    double below = 0;
-    for (const auto& [probability, weight] : weighted) {
-      below += weight;
-      if (below >= 0.5 * total) {
-        out.planarity[i] = probability;
-        break;
-      }
-    }
   }
   return out;
 }
@@ -199,7 +172,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(cell >= 1 && !window_sizes.empty() && !window_aspects.empty());
   for (const double s : window_sizes) PDVO_CHECK_OPTION(s >= cell);
   for (const double a : window_aspects) PDVO_CHECK_OPTION(a > 0 && a <= 16 && a >= 1.0 / 16);
-  PDVO_CHECK_OPTION(overlap >= 0 && overlap < 1 && normal_scale_deg > 0 && planarity_sigma >= 0);
+  PDVO_CHECK_OPTION(overlap >= 0 && overlap < 1 && normal_scale_deg > 0);
   PDVO_CHECK_OPTION(distance_scale > 0 && colour_scale > 0 && plane_smoothness >= 0);
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
@@ -262,7 +235,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   // 2. Per point: the windows that hold it.
   t = Clock::now();
   const int n = static_cast<int>(d.points.size());
-  PointPooling pooled = PoolWindows(d.points, d.windows, o.normal_scale_deg, o.planarity_sigma);
+  PointPooling pooled = PoolWindows(d.points, d.windows, o.normal_scale_deg);
   d.planarity = std::move(pooled.planarity);
   d.normals = std::move(pooled.normals);
   d.times.pooling = Ms(t);

@@ -35,13 +35,6 @@ TEST(Detector, PoolsTheWindowsThatHoldAPoint) {
   EXPECT_DOUBLE_EQ(p.planarity[2], 0.5);       // no window: undecided
   EXPECT_LT((p.normals[0] - a).norm(), 0.05);  // the light, far normal b hardly moves the robust mean
   EXPECT_EQ(p.normals[2], Eigen::Vector3d::Zero());
-  // Weighted by where the point lies: point 1 (50, 10) is at the middle of window 3 (0.6) and near the edges of
-  // windows 1 and 2 (0.8, 0.2), so window 3 decides; point 0 (10, 10) is nearest the middle of window 0 (0.9).
-  const PointPooling w = PoolWindows(points, windows, 15, 0.5);
-  EXPECT_DOUBLE_EQ(w.planarity[0], 0.9);
-  EXPECT_DOUBLE_EQ(w.planarity[1], 0.6);
-  EXPECT_DOUBLE_EQ(w.planarity[2], 0.5);
-  EXPECT_EQ(w.normals[0], p.normals[0]);  // normals are pooled as before
 }
 
 // Windows anywhere (not on a grid), points anywhere: each point pools exactly the windows that hold its pixel, as a
@@ -79,30 +72,6 @@ TEST(Detector, PoolingEqualsTheDirectComputation) {
     EXPECT_EQ(pooled.normals[i], RobustMeanDirection(normals, probabilities, 15)) << i;
   }
   EXPECT_GT(held, 200);  // most points lie in some window
-  // Weighted: the smallest probability whose windows, with those of smaller ones, hold half the weight.
-  constexpr double kSigma = 0.5;
-  const PointPooling weighted = PoolWindows(points, windows, 15, kSigma);
-  for (size_t i = 0; i < points.size(); ++i) {
-    std::vector<std::pair<double, double>> pw;
-    double total = 0;
-    for (const DetectedWindow& w : windows) {
-      if (!w.box.contains(NearestPixel(points[i]))) continue;
-      const double dx = (points[i].x - w.box.x - w.box.width / 2.0) / (w.box.width / 2.0);
-      const double dy = (points[i].y - w.box.y - w.box.height / 2.0) / (w.box.height / 2.0);
-      pw.emplace_back(w.plane_probability, std::exp(-(dx * dx + dy * dy) / (2 * kSigma * kSigma)));
-      total += pw.back().second;
-    }
-    double expected = 0.5;  // no window
-    if (!pw.empty()) {
-      expected = 1;
-      for (const auto& [p, w] : pw) {  // brute force
-        double below = 0;
-        for (const auto& [q, v] : pw) below += q <= p ? v : 0;
-        if (below >= 0.5 * total) expected = std::min(expected, p);
-      }
-    }
-    EXPECT_NEAR(weighted.planarity[i], expected, 1e-12) << i;
-  }
 }
 
 struct StreetFrame {

@@ -34,10 +34,6 @@ struct DetectorOptions {
   double overlap = 0.5;              // share of a window's side that the next window of its shape overlaps
   bool fuse_window_normals = false;  // fuse each window's normal with its edges' vanishing direction (slower)
   double normal_scale_deg = 15;      // the Cauchy scale of a point's robust mean normal
-  // A point's planarity weighs each window holding it by a Gaussian of the point's distance from the window's
-  // centre, in half sides, of this sigma (a window says most about its middle); 0: all alike. 0.5: less false
-  // plane area on synthetic streets, but less plane recall on the real sets (docs/detector.md).
-  double planarity_sigma = 0;
   // The graph's edges: weight = exp(-(distance / distance_scale)^2 / 2) exp(-(colour difference / colour_scale)^2
   // / 2), colours in [0, 1] per channel.
   double distance_scale = 25;  // px
@@ -76,7 +72,6 @@ struct DetectorOptions {
     visit("overlap", self.overlap);
     visit("fuse_window_normals", self.fuse_window_normals);
     visit("normal_scale_deg", self.normal_scale_deg);
-    visit("planarity_sigma", self.planarity_sigma);
     visit("distance_scale", self.distance_scale);
     visit("colour_scale", self.colour_scale);
     visit("plane_smoothness", self.plane_smoothness);
@@ -120,16 +115,14 @@ struct DetectedWindow {
 };
 
 // Per point, from the windows that hold it (Region::Contains): its planarity, the median of their plane
-// probabilities (0.5 if none; with `planarity_sigma` > 0 the weighted median, each window weighted by
-// exp(-r^2 / 2 planarity_sigma^2), r the point's distance from the window's centre with the window's half sides as
-// units), and its normal, their normals' robust mean weighted by their probabilities (Cauchy scale
-// `normal_scale_deg`; zero if none).
+// probabilities (0.5 if none), and its normal, their normals' robust mean weighted by their probabilities (Cauchy
+// scale `normal_scale_deg`; zero if none).
 struct PointPooling {
   std::vector<double> planarity;
   std::vector<Eigen::Vector3d> normals;
 };
 PointPooling PoolWindows(const std::vector<cv::Point2f>& points, const std::vector<DetectedWindow>& windows,
-                         double normal_scale_deg, double planarity_sigma = 0);
+                         double normal_scale_deg);
 
 struct DetectedSegment {
   bool planar = false;
