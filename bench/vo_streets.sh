@@ -58,5 +58,6 @@ done | awk -v opts="$*" -v runs="${#sigmas[@]}" '
       sum += m; sq += m * m; if (m > 1) above++; if (m > max) max = m
     }
     mean = sum / n; var = sq / n - mean * mean; se = n > 1 && var > 0 ? sqrt(var / (n - 1)) : 0
-    printf "mean %.3f%% over %d streets%s (max %.2f%%, standard error over the streets %.3f%%), %d above 1%%; lost %d times, %d frames uncertain [%s]\n",
-      mean, n, (runs > 0 ? sprintf(", %d runs each", runs) : ""), max, se, above, lost, uncertain, opts }'
+    printf "mean %.3f%% over %d streets%s (max %.2f%%, standard error over the streets %.3f%%), %d above 1%%; lost %d times, %d frames uncertain%s [%s]\n",
+      mean, n, (runs > 0 ? sprintf(", %d runs each", runs) : ""), max, se, above, lost, uncertain,
+      (runs > 1 ? " (summed over all runs)" : ""), opts }'
