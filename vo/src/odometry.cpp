@@ -79,8 +79,6 @@ struct Odometry::Impl {
   double last_time = 0;
   bool started = false;
   HealthCheck health;
-  int last_keyframe_frame = 0;  // its index (FollowTurnover)
-  int feature_scale = 1;        // of min_features and new_features (FollowTurnover)
   int segment = 0;
   double adaptation = 1;  // of the motion noise (MotionNoise::max_adaptation)
   int rough_frames = 0;   // in a row whose innovations exceed kNisHigh
@@ -123,8 +121,7 @@ struct Odometry::Impl {
                 &start->corners);
         stats.keyframe = stats.bootstrap = true;
       } else if (static_cast<int>(tracks.Visible(*filter, camera, o.features.border).size()) <
-                 o.features.min_features * feature_scale) {
-        FollowTurnover();
+                 o.features.min_features) {
         stats.keyframe = MakeKeyframe(grey, timestamp, nullptr);
         const int reference = stats.keyframe ? filter->references().rbegin()->first : -1;
         if (health.AtKeyframe(grey, filter->camera().world_from_cam(), reference, evidence))
@@ -183,19 +180,6 @@ struct Odometry::Impl {
       adaptation = std::min(o.motion.max_adaptation, 2 * adaptation);
     } else if (stats.nis < kNisLow) {
       adaptation = std::max(1.0, adaptation / kAdaptationDecay);
-    }
-  }
-
-  // Keyframes closer than features.fast_turnover frames: twice the features, until they are twice as far apart.
-  void FollowTurnover() {
-    const int frame = static_cast<int>(trajectory.size());
-    const int since = frame - last_keyframe_frame;
-    last_keyframe_frame = frame;
-    if (o.features.fast_turnover == 0) return;
-    if (since < o.features.fast_turnover) {
-      feature_scale = 2;
-    } else if (since > 2 * o.features.fast_turnover) {
-      feature_scale = 1;
     }
   }
 
@@ -342,7 +326,7 @@ struct Odometry::Impl {
                  cv::Scalar(0), cv::FILLED);
     }
     std::vector<cv::Point2f> found;
-    const int new_features = o.features.new_features * feature_scale;
+    const int new_features = o.features.new_features;
     cv::goodFeaturesToTrack(grey, found, kCornersPerNewFeature * new_features, kCornerQuality, o.features.min_distance,
                             mask);
     if (found.empty()) return false;

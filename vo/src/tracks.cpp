@@ -10,7 +10,7 @@ namespace pdvo::vo {
 
 bool FeatureOptions::Check() const {
   PDVO_CHECK_OPTION(max_measurements >= 1 && min_features >= 1 && new_features >= 1 && min_distance >= 1);
-  PDVO_CHECK_OPTION(fast_turnover >= 0 && max_waiting >= 0);
+  PDVO_CHECK_OPTION(max_waiting >= 0);
   PDVO_CHECK_OPTION(border >= 1 && max_misses >= 1 && min_rejections >= 1 && max_rejected_share >= 0);
   return true;
 }

@@ -20,14 +20,11 @@ class MapRecord;
 
 struct FeatureOptions {
   int max_measurements = 200;  // features searched for per frame, at most
-  int min_features = 20;       // fewer in view: a new keyframe
-  int new_features = 25;       // features initialised per keyframe, at most
-  // Features that the motion takes away within this many frames (keyframes closer than this, as from a car):
-  // min_features and new_features double until keyframes are twice as far apart again. 0: never.
-  int fast_turnover = 8;
-  double min_distance = 12;  // px between features at initialisation
-  int border = 10;           // px: features nearer the image border leave
-  int max_misses = 3;        // failed searches in a row before a feature leaves
+  int min_features = 60;       // fewer in view: a new keyframe
+  int new_features = 80;       // features initialised per keyframe, at most
+  double min_distance = 12;    // px between features at initialisation
+  int border = 10;             // px: features nearer the image border leave
+  int max_misses = 3;          // failed searches in a row before a feature leaves
   // Points whose predictions have left the view wait, out of the measurements, to be measured again if they come
   // back; beyond this many, the oldest leave. 0: a point leaves as it leaves the view. 80 carried the scale
   // further on aliased driving streets, not on supersampled ones nor on KITTI 06; hand-held (TUM fr1) it costs
@@ -43,7 +40,6 @@ struct FeatureOptions {
     visit("max_measurements", self.max_measurements);
     visit("min_features", self.min_features);
     visit("new_features", self.new_features);
-    visit("fast_turnover", self.fast_turnover);
     visit("min_distance", self.min_distance);
     visit("border", self.border);
     visit("max_misses", self.max_misses);
