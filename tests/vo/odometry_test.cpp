@@ -201,8 +201,9 @@ TEST(Odometry, IdppModeGrowsPlanes) {
 }
 
 // The 3D consistency test's gate keeps a blind plane's points on one surface. With 25 features per keyframe (20
-// in view at least), where IDPP's planes grow on this street; with today's 80 (60) the points take the corners
-// near the seeds and IDPP's planes hardly grow here (53 plane points, purity 0.57; 0.80 with a gate of 3).
+// in view at least), where IDPP's planes grow on this street; with the default 80 (60) most blind seeds die
+// before they grow (docs/experiments/2026-12-07-more-features.md): 53 plane points here, purity 0.57, 0.80 with a
+// gate of 3.
 TEST(Odometry, PlanePointsLieOnOneSurface) {
   const Street& s = TestStreet();
   VoOptions options;
