@@ -326,9 +326,8 @@ struct Odometry::Impl {
                  cv::Scalar(0), cv::FILLED);
     }
     std::vector<cv::Point2f> found;
-    const int new_features = o.features.new_features;
-    cv::goodFeaturesToTrack(grey, found, kCornersPerNewFeature * new_features, kCornerQuality, o.features.min_distance,
-                            mask);
+    cv::goodFeaturesToTrack(grey, found, kCornersPerNewFeature * o.features.new_features, kCornerQuality,
+                            o.features.min_distance, mask);
     if (found.empty()) return false;
     const std::vector<DepthPrior> known = priors ? *priors : MappedInView();
 
@@ -350,7 +349,7 @@ struct Odometry::Impl {
     std::vector<Filter::NewPoint> points;
     std::vector<Eigen::Vector2d> pixels;
     for (Corner& c : keyframe.corners) {
-      if (c.used || static_cast<int>(points.size() + seeds.size()) >= new_features) continue;
+      if (c.used || static_cast<int>(points.size() + seeds.size()) >= o.features.new_features) continue;
       c.used = true;
       const double rho = PriorInverseDepth(known, c.pixel);
       points.push_back({camera.Ray(c.pixel), rho, PriorSigma(rho)});
