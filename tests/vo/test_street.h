@@ -25,35 +25,50 @@ struct Street {
   std::vector<std::vector<DetectedPlane>> planes;  // the frame's exact annotation (sim::AnnotateFrame)
 };
 
+// `frames` frames of the street (at least `min_length` m) and walk of `seed`.
+inline Street MakeStreet(const sim::SynthOptions& options, int frames, uint64_t seed, double min_length) {
+  Street s;
+  s.options = options;
+  s.street = sim::GenerateStreet(options.street, min_length, seed);
+  s.walk = sim::WalkStreet(s.street, options.walk, frames, seed);
+  s.camera = options.MakeCamera();
+  const sim::Renderer renderer(s.street, s.camera, options.render, seed);
+  for (const StampedPose& pose : s.walk) {
+    sim::RenderedFrame frame;
+    renderer.Render({pose.world_from_cam}, pose.timestamp, s.grey.size(), &frame);
+    cv::Mat grey;
+    cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
+    s.grey.push_back(grey);
+    s.depth.push_back(frame.depth);
+    s.colour.push_back(frame.image);
+    s.planes.push_back(
+        DetectedPlanes(sim::AnnotateFrame(s.street, frame, pose.world_from_cam, s.camera, ""), s.camera.width));
+    cv::Mat surface(frame.id.size(), CV_16S);
+    for (int y = 0; y < surface.rows; ++y) {
+      for (int x = 0; x < surface.cols; ++x) {
+        const int id = frame.id.at<int>(y, x);
+        surface.at<int16_t>(y, x) = static_cast<int16_t>(id >= 0 ? s.street.planes.at(id).surface : -1);
+      }
+    }
+    s.surface.push_back(surface);
+  }
+  return s;
+}
+
 // 150 frames at 30 frames/s: 7 m of walking.
 inline const Street& TestStreet() {
+  static const Street s = MakeStreet(sim::SynthOptions(), 150, 3, 40);
+  return s;
+}
+
+// A walk round a block whose first 150 frames turn the first corner (26 degrees by frame 32; `pdvo synth --seed 410
+// -n 150 --set street.loop=true`).
+inline const Street& CornerStreet() {
   static const Street s = [] {
-    Street s;
+    sim::SynthOptions options;
+    options.street.loop = true;
     constexpr int kFrames = 150;
-    s.street = sim::GenerateStreet(s.options.street, 40, 3);
-    s.walk = sim::WalkStreet(s.street, s.options.walk, kFrames, 3);
-    s.camera = s.options.MakeCamera();
-    const sim::Renderer renderer(s.street, s.camera, s.options.render, 3);
-    for (const StampedPose& pose : s.walk) {
-      sim::RenderedFrame frame;
-      renderer.Render({pose.world_from_cam}, pose.timestamp, s.grey.size(), &frame);
-      cv::Mat grey;
-      cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
-      s.grey.push_back(grey);
-      s.depth.push_back(frame.depth);
-      s.colour.push_back(frame.image);
-      s.planes.push_back(
-          DetectedPlanes(sim::AnnotateFrame(s.street, frame, pose.world_from_cam, s.camera, ""), s.camera.width));
-      cv::Mat surface(frame.id.size(), CV_16S);
-      for (int y = 0; y < surface.rows; ++y) {
-        for (int x = 0; x < surface.cols; ++x) {
-          const int id = frame.id.at<int>(y, x);
-          surface.at<int16_t>(y, x) = static_cast<int16_t>(id >= 0 ? s.street.planes.at(id).surface : -1);
-        }
-      }
-      s.surface.push_back(surface);
-    }
-    return s;
+    return MakeStreet(options, kFrames, 410, options.walk.speed * kFrames / options.walk.fps + 30.0);
   }();
   return s;
 }

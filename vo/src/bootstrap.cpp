@@ -1,5 +1,6 @@
 #include "pdvo/vo/bootstrap.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -53,6 +54,26 @@ double MedianUnexplainedByRotation(const std::vector<Eigen::Vector3d>& first,
   return Median(angles);
 }
 
+// The essential matrix [t]x R of the rotation R (x_second = R x_first + t) whose direction t best fits the inliers'
+// epipolar constraints: t is orthogonal to every (R f1) x f2 of their bearings f1, f2, so it is the least eigenvector
+// of those vectors' scatter (its sign is left to cv::recoverPose).
+cv::Mat EssentialGivenRotation(const Camera& camera, const std::vector<cv::Point2f>& from,
+                               const std::vector<cv::Point2f>& to, const cv::Mat& inliers,
+                               const Eigen::Matrix3d& rotation) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < from.size(); ++i) {
+    if (!inliers.at<uchar>(static_cast<int>(i))) continue;
+    const Eigen::Vector3d first = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).normalized();
+    const Eigen::Vector3d second = camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized();
+    const Eigen::Vector3d normal = (rotation * first).cross(second);
+    scatter += normal * normal.transpose();
+  }
+  const Eigen::Vector3d t = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+  cv::Mat e;
+  cv::eigen2cv(Eigen::Matrix3d(Hat(t) * rotation), e);
+  return e;
+}
+
 }  // namespace
 
 bool BootstrapOptions::Check() const {
@@ -61,12 +82,15 @@ bool BootstrapOptions::Check() const {
 }
 
 bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
-                     double parallax_deg, double inverse_depth, TwoViewMotion* motion) {
+                     double parallax_deg, double inverse_depth, TwoViewMotion* motion,
+                     const std::optional<Eigen::Quaterniond>& given_rotation) {
   if (from.size() < kBootstrapInliers || from.size() != to.size()) return false;
   cv::Mat inliers;
-  const cv::Mat e =
-      cv::findEssentialMat(from, to, camera.K(), cv::RANSAC, kRansacConfidence, kRansacThreshold, inliers);
+  cv::Mat e = cv::findEssentialMat(from, to, camera.K(), cv::RANSAC, kRansacConfidence, kRansacThreshold, inliers);
   if (e.rows != 3 || e.cols != 3) return false;
+  if (given_rotation) {
+    e = EssentialGivenRotation(camera, from, to, inliers, given_rotation->conjugate().toRotationMatrix());
+  }
   cv::Mat r, t, triangulated;
   cv::recoverPose(e, from, to, camera.K(), r, t, kFarthest, inliers, triangulated);
   // x_second = R x_first + t, |t| = 1.
@@ -174,7 +198,8 @@ void TwoViewBootstrap::Begin(const cv::Mat& grey, double timestamp, size_t index
   first_ = first;
 }
 
-std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double timestamp) {
+std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double timestamp,
+                                                     const Eigen::Quaterniond& orientation) {
   if (!active_) return std::nullopt;
   std::vector<cv::Point2f> next;
   std::vector<uchar> status;
@@ -194,7 +219,8 @@ std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double
     return std::nullopt;
   }
   TwoViewMotion motion;
-  const bool enough = EstimateTwoView(camera_, tracks_.front(), tracks_.back(), o_.parallax, inverse_depth_, &motion);
+  const bool enough = EstimateTwoView(camera_, tracks_.front(), tracks_.back(), o_.parallax, inverse_depth_, &motion,
+                                      first_.orientation.conjugate() * orientation);
   // Its direction must agree with the motion found a frame before (kMaxDirectionChange).
   const std::optional<Eigen::Vector3d> before = std::exchange(last_direction_, std::nullopt);
   if (motion.found) last_direction_ = motion.first_from_second.translation.normalized();

@@ -114,7 +114,7 @@ struct Odometry::Impl {
         record.KeepAll(*filter, tracks);
         Start(grey, timestamp, at);
         stats.keyframe = true;
-      } else if (std::optional<BootstrapStart> start = bootstrap.Step(grey, timestamp)) {
+      } else if (std::optional<BootstrapStart> start = bootstrap.Step(grey, timestamp, filter->camera().orientation)) {
         for (const auto& [index, pose] : start->revised) trajectory.at(index).world_from_cam = pose;
         record.DiscardFilter();
         Restart(grey, timestamp, start->camera, o.bootstrap.velocity_sigma * start->camera.velocity.norm(),

@@ -8,8 +8,12 @@
 // Without enough parallax after `frames` frames (a camera that only turns) it gives up and the filter goes on.
 // Nearly pure forward motion can give one frame an essential matrix of sideways motion and a turn, which shows
 // more parallax than the true one and so passes the test where the true one does not: the motion must also agree
-// with the one found a frame before (its direction within kMaxDirectionChange). Known weakness (docs): the
-// frame-to-frame tracks drift, which adds parallax, so far corners come out too near.
+// with the one found a frame before (its direction within kMaxDirectionChange). The rotation is the filter's, not
+// the essential matrix's: the filter finds rotation from bearings alone, while two views of a camera that turns
+// far more than its baseline shows confound the turn with sideways motion (on streets round a block the essential
+// matrix's turn was off by 1.7 degrees on average, up to 7.6, the filter's by 0.55; the filter then held on to the
+// wrong turn rate: docs/experiments/2026-12-07-bootstrap-rotation.md). Known weakness (docs): the frame-to-frame
+// tracks drift, which adds parallax, so far corners come out too near.
 //
 // Pixels are those of the working camera (undistorted); the first camera's frame is x right, y down, z forward.
 #pragma once
@@ -62,10 +66,11 @@ struct TwoViewMotion {
 // 1 / inverse_depth; false if fewer than kBootstrapInliers (or fewer than half) are inliers, if their median
 // parallax is under `parallax_deg`, or if a pure rotation would leave them under half of that (a turn in front of
 // a near wall is not a translation). Refused for too few inliers in share or too little parallax, the motion is
-// still `found`, with a unit translation.
+// still `found`, with a unit translation. With `given_rotation` (first_from_second's) the essential matrix's
+// rotation is replaced by it and only the direction of motion is fitted to the inliers.
 bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& first,
                      const std::vector<cv::Point2f>& second, double parallax_deg, double inverse_depth,
-                     TwoViewMotion* motion);
+                     TwoViewMotion* motion, const std::optional<Eigen::Quaterniond>& given_rotation = std::nullopt);
 
 // How far the motion `first_from_second` (the filter's between two keyframes; the length of its translation does
 // not matter) is from what the frames themselves show, as a check of the filter: corners of `first` (at least
@@ -96,7 +101,8 @@ class TwoViewBootstrap {
   bool active() const { return active_; }
   // Tracks the corners into the next frame. The start when the two views suffice (the bootstrap is then off);
   // nothing while it waits, or once it has given up (too few tracks left, or more than options.frames frames).
-  std::optional<BootstrapStart> Step(const cv::Mat& grey, double timestamp);
+  // `orientation`: the filter's world_from_cam rotation at this frame (the motion's rotation is taken from it).
+  std::optional<BootstrapStart> Step(const cv::Mat& grey, double timestamp, const Eigen::Quaterniond& orientation);
 
  private:
   void Stop();
