@@ -159,6 +159,9 @@ cv::FileStorage OpenYamlText(const std::string& text, const std::string& where) 
   try {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
+    // OpenCV takes YAML only after its header line, and says so as an unsupported format.
+    PDVO_THROW_CHECK(text.starts_with("%YAML"), FormatError,
+                     where << ": OpenCV's YAML reader needs the header line %YAML:1.0 (then ---) first");
     PDVO_THROW(FormatError, where << ": not valid YAML (" << e.err << ")");
   } catch (const std::length_error& e) {  // OpenCV's parser on some malformed keys (found by fuzzing)
     PDVO_THROW(FormatError, where << ": not valid YAML (OpenCV's parser failed: " << e.what() << ")");

@@ -192,6 +192,9 @@ TEST(Options, YamlThatWouldHangOrCrashOpenCvIsRefused) {
   EXPECT_EQ(message_of("%YAML:1.0\n cx: A\n---\n-a: 5\n"), where + ": line 3: a second YAML document");
   // Cut short: refused at the end of the input.
   EXPECT_EQ(message_of("%YAML:1.0\nouter: {scale: [1").rfind(where + ": not valid YAML (line ", 0), 0u);
+  // Without OpenCV's header line, OpenCV refuses the file: the message says what is missing.
+  EXPECT_EQ(message_of("outer:\n  scale: [1, 2]\n"),
+            where + ": OpenCV's YAML reader needs the header line %YAML:1.0 (then ---) first");
   // OpenCV's own header, with and without the document start, and a plain YAML file are taken.
   EXPECT_NO_THROW(CheckYamlText("%YAML:1.0\n---\na: 1\n", "x"));
   EXPECT_NO_THROW(CheckYamlText("%YAML:1.0\na: [1, 2]\nb: {c: 3}\n", "x"));
