@@ -95,26 +95,37 @@ TEST(Bootstrap, TakesAGivenRotation) {
   EXPECT_LT(given, 0.5 * free) << "direction error, degrees: " << given << " given the rotation, " << free << " not";
 }
 
+// Refused with the essential matrix's own rotation and with the true one given (as the odometry gives the filter's).
 TEST(Bootstrap, RefusesViewsWithoutParallax) {
   const Rigid3d turn(Eigen::Quaterniond(Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitY())),
                      Eigen::Vector3d::Zero());
   const TwoViews v = Generate(turn, 150, 4);
+  const Rigid3d side(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.5, 0, 0));
+  const TwoViews few = Generate(side, 20, 5);
   TwoViewMotion motion;
-  EXPECT_FALSE(EstimateTwoView(kCamera, v.first, v.second, 1.5, 0.2, &motion));
-  const TwoViews few = Generate(Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.5, 0, 0)), 20, 5);
-  EXPECT_FALSE(EstimateTwoView(kCamera, few.first, few.second, 1.5, 0.2, &motion));  // too few to trust
+  for (const bool given : {false, true}) {
+    SCOPED_TRACE(given ? "rotation given" : "essential matrix's rotation");
+    const auto rotation = [&](const Rigid3d& m) { return given ? std::optional(m.rotation) : std::nullopt; };
+    EXPECT_FALSE(EstimateTwoView(kCamera, v.first, v.second, 1.5, 0.2, &motion, rotation(turn)));
+    EXPECT_FALSE(EstimateTwoView(kCamera, few.first, few.second, 1.5, 0.2, &motion, rotation(side)));  // too few
+  }
 }
 
 // A camera moving sideways by 12 cm past a wall of nearly one depth (3-3.5 m): the rays meet at 2 degrees, but a
 // turn of the camera explains the views nearly as well (the flow of a sideways step and of a turn differ only
 // with depth), so the motion's direction is ill-determined: refused. A longer step past a deep scene is accepted.
+// Also with the true rotation given.
 TEST(Bootstrap, RefusesParallaxThatATurnExplains) {
   const Rigid3d step(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.12, 0, 0));
   TwoViewMotion motion;
   const TwoViews shallow = Generate(step, 150, 6, 3, 3.5);
-  EXPECT_FALSE(EstimateTwoView(kCamera, shallow.first, shallow.second, 1.5, 0.2, &motion));
   const TwoViews deep = Generate(Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.4, 0, 0)), 150, 6, 2, 12);
-  EXPECT_TRUE(EstimateTwoView(kCamera, deep.first, deep.second, 1.5, 0.2, &motion));
+  for (const std::optional<Eigen::Quaterniond>& rotation :
+       {std::optional<Eigen::Quaterniond>(), std::optional(step.rotation)}) {
+    SCOPED_TRACE(rotation ? "rotation given" : "essential matrix's rotation");
+    EXPECT_FALSE(EstimateTwoView(kCamera, shallow.first, shallow.second, 1.5, 0.2, &motion, rotation));
+    EXPECT_TRUE(EstimateTwoView(kCamera, deep.first, deep.second, 1.5, 0.2, &motion, rotation));
+  }
 }
 
 // Frames of a textured wall 4 m away, seen while the camera slides 2 cm a frame to the right: the image moves left

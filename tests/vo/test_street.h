@@ -25,12 +25,12 @@ struct Street {
   std::vector<std::vector<DetectedPlane>> planes;  // the frame's exact annotation (sim::AnnotateFrame)
 };
 
-// `frames` frames of the street (at least `min_length` m) and walk of `seed`.
-inline Street MakeStreet(const sim::SynthOptions& options, int frames, uint64_t seed, double min_length) {
+// The frames of `walked` rendered with the renderer of `seed`, and their truth.
+inline Street MakeStreet(const sim::SynthOptions& options, sim::WalkedStreet walked, uint64_t seed) {
   Street s;
   s.options = options;
-  s.street = sim::GenerateStreet(options.street, min_length, seed);
-  s.walk = sim::WalkStreet(s.street, options.walk, frames, seed);
+  s.street = std::move(walked.street);
+  s.walk = std::move(walked.walk);
   s.camera = options.MakeCamera();
   const sim::Renderer renderer(s.street, s.camera, options.render, seed);
   for (const StampedPose& pose : s.walk) {
@@ -57,7 +57,13 @@ inline Street MakeStreet(const sim::SynthOptions& options, int frames, uint64_t 
 
 // 150 frames at 30 frames/s: 7 m of walking.
 inline const Street& TestStreet() {
-  static const Street s = MakeStreet(sim::SynthOptions(), 150, 3, 40);
+  static const Street s = [] {
+    const sim::SynthOptions options;
+    sim::WalkedStreet walked;
+    walked.street = sim::GenerateStreet(options.street, 40, 3);
+    walked.walk = sim::WalkStreet(walked.street, options.walk, 150, 3);
+    return MakeStreet(options, std::move(walked), 3);
+  }();
   return s;
 }
 
@@ -67,8 +73,7 @@ inline const Street& CornerStreet() {
   static const Street s = [] {
     sim::SynthOptions options;
     options.street.loop = true;
-    constexpr int kFrames = 150;
-    return MakeStreet(options, kFrames, 410, options.walk.speed * kFrames / options.walk.fps + 30.0);
+    return MakeStreet(options, sim::MakeWalkedStreet(options, 150, 410), 410);
   }();
   return s;
 }
