@@ -373,5 +373,19 @@ TEST(Synth, DrivingConfigDrivesACar) {
   EXPECT_LT(o.walk.lateral_offset, o.street.road_width / 2);
 }
 
+// The KITTI-view driving set is the driving set seen through KITTI's camera reduced to 320 px: the same street and
+// drive (its other options repeat driving.yaml's and must not drift from them), 320x97 pixels and fx 184.6 px.
+TEST(Synth, KittiViewConfigIsTheDrivingSetThroughKittisCamera) {
+  SynthOptions kitti = LoadOptions<SynthOptions>(PDVO_SOURCE_DIR "/sim/config/driving_kitti.yaml", "synth");
+  const SynthOptions driving = LoadOptions<SynthOptions>(PDVO_SOURCE_DIR "/sim/config/driving.yaml", "synth");
+  EXPECT_EQ(kitti.width, 320);
+  EXPECT_EQ(kitti.height, 97);
+  EXPECT_NEAR(2 * std::atan(160 / kitti.fx) * 180 / M_PI, 81.8, 0.1);  // KITTI 06: 1226 px wide, fx 707.1 px
+  kitti.width = driving.width;
+  kitti.height = driving.height;
+  kitti.fx = driving.fx;
+  EXPECT_EQ(kitti, driving);
+}
+
 }  // namespace
 }  // namespace pdvo::sim
