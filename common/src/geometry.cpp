@@ -1,9 +1,14 @@
 #include "pdvo/common/geometry.h"
 
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 
 namespace pdvo {
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
+}
 
 Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;

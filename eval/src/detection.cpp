@@ -7,6 +7,7 @@
 #include "compare.h"
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 
 namespace pdvo {
 namespace {
@@ -14,9 +15,6 @@ namespace {
 double Ratio(double a, double b) { return b > 0 ? a / b : 0.0; }
 double F1(double p, double r) { return p + r > 0 ? 2 * p * r / (p + r) : 0.0; }
 using detail::Median;
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
-}
 // n choose 2.
 double Pairs(double n) { return 0.5 * n * (n - 1); }
 nlohmann::json ToJson(const Unmatched& u) {

@@ -14,6 +14,21 @@ Eigen::Vector3d RandomVector(std::mt19937& rng, double scale) {
   return {n(rng), n(rng), n(rng)};
 }
 
+// Known angles between directions, whatever the vectors' lengths; parallel and opposite vectors (where rounding can
+// push the cosine past +-1) give 0 and 180, not NaN (to 1e-5 degrees: acos near +-1 turns a rounding of 1e-16 into 1e-8
+// rad).
+TEST(Geometry, AngleBetweenDirections) {
+  EXPECT_NEAR(AngleDeg(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 3, 0)), 90, 1e-12);
+  EXPECT_NEAR(AngleDeg(Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(1, 1, 0)), 45, 1e-12);
+  EXPECT_NEAR(AngleDeg(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, std::sin(0.3), std::cos(0.3))), 0.3 * 180 / M_PI,
+              1e-12);
+  const Eigen::Vector3d v(0.1, 0.7, -0.3);
+  for (double scale : {5.0, 1e-3, 1e6}) {
+    EXPECT_NEAR(AngleDeg(v, scale * v), 0, 1e-5) << scale;
+    EXPECT_NEAR(AngleDeg(v, -scale * v), 180, 1e-5) << scale;
+  }
+}
+
 TEST(Geometry, HatIsTheCrossProduct) {
   std::mt19937 rng(1);
   for (int i = 0; i < 20; ++i) {

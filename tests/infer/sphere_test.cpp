@@ -8,13 +8,10 @@
 #include <random>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 
 namespace pdvo {
 namespace {
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
-}
 
 // `n` directions within about `sigma_deg` of `centre`.
 void Scatter(const Eigen::Vector3d& centre, int n, double sigma_deg, double weight, std::mt19937& rng,

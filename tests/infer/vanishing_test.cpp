@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/infer/vanishing.h"
 
 namespace pdvo {
@@ -20,10 +21,6 @@ const Camera kCamera = [] {
   c.fx = c.fy = 277.0;
   return c;
 }();
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kDegree;
-}
 
 // A vertical plane 6 m ahead whose normal points `azimuth_deg` from the optical axis, lined with horizontal
 // and vertical lines, seen by a camera pitched and rolled by the given angles (the world's y axis is down).

@@ -7,6 +7,8 @@
 
 #include <random>
 
+#include "pdvo/common/geometry.h"
+
 namespace pdvo::vo {
 namespace {
 
@@ -60,10 +62,6 @@ TEST(Bootstrap, FindsAKnownMotion) {
   }
   std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
   EXPECT_NEAR(distances[distances.size() / 2], 1 / kInverseDepth, 1e-9);
-}
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
 }
 
 // Given the rotation, the bootstrap keeps it and finds the direction from the correspondences: exactly on exact

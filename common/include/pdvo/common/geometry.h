@@ -20,6 +20,9 @@ Eigen::Matrix3d Hat(const Eigen::Vector3d& v);
 Eigen::Quaterniond ExpSO3(const Eigen::Vector3d& phi);
 Eigen::Vector3d LogSO3(const Eigen::Quaterniond& q);
 
+// The angle between two directions (vectors of any non-zero length), in degrees, in [0, 180].
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
+
 // The left Jacobian of SO(3) at phi, used by the SE(3) maps.
 Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& phi);
 
