@@ -13,8 +13,8 @@ if [ "${1:-}" = "-h" ] || [ "${1:-}" = "--help" ]; then
   exit 0
 fi
 here=$(dirname "$0")
-modes=(${MODES:-points idpp pdvo})
-sets=(${SETS:-walking driving loop kitti_view real})
+read -ra modes <<<"${MODES:-points idpp pdvo}"
+read -ra sets <<<"${SETS:-walking driving loop kitti_view real}"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # The round-a-block streets: the default street with loop set (the demo's kind).
