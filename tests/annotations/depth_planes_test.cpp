@@ -6,6 +6,7 @@
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 #include "pdvo/test/scenes.h"
 #include "pdvo/test/support.h"
@@ -31,8 +32,7 @@ Recovered Recover(const Annotation& a, const test::RenderedDepth& truth, int id,
     const cv::Mat mask = RasteriseShape(s, a);
     if (cv::countNonZero(mask & want) < 0.5 * cv::countNonZero(mask)) continue;
     got |= mask & ~near_bush;
-    r.worst_angle_deg =
-        std::max(r.worst_angle_deg, std::acos(std::clamp(s.normal->dot(normal), -1.0, 1.0)) * 180 / M_PI);
+    r.worst_angle_deg = std::max(r.worst_angle_deg, AngleDeg(*s.normal, normal));
   }
   r.iou = cv::countNonZero(want & got) / static_cast<double>(cv::countNonZero(want | got));
   return r;

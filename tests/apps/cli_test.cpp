@@ -13,6 +13,7 @@
 
 #include "pdvo/annotations/annotation.h"
 #include "pdvo/common/file_io.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 #include "pdvo/common/trajectory.h"
 #include "pdvo/infer/model.h"
@@ -381,7 +382,7 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
       if (!r.contains("true_normal")) continue;
       const Eigen::Vector3d n(r["normal"][0], r["normal"][1], r["normal"][2]);
       const Eigen::Vector3d t(r["true_normal"][0], r["true_normal"][1], r["true_normal"][2]);
-      error_sum += std::acos(std::clamp(n.normalized().dot(t.normalized()), -1.0, 1.0)) * 180 / M_PI;
+      error_sum += AngleDeg(n, t);
       ++normals;
     }
   }

@@ -13,6 +13,7 @@
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 #include "pdvo/infer/sphere.h"
 #include "pdvo/sim/renderer.h"
@@ -121,7 +122,7 @@ TEST(Detector, FindsTheLargePlanesOfARenderedStreet) {
       ++large;
       for (const AnnotationShape& shape : detected.shapes) {
         if (!shape.IsPlane()) continue;
-        const double angle = std::acos(std::clamp(shape.normal->dot(*truth.normal), -1.0, 1.0)) * 180 / M_PI;
+        const double angle = AngleDeg(*shape.normal, *truth.normal);
         if (Iou(RasteriseShape(shape, detected), t) >= 0.4 && angle <= 30) {
           ++found;
           break;

@@ -13,6 +13,7 @@
 #include "pdvo/common/dataset.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/common/file_io.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 #include "pdvo/eval/plane_match.h"
 #include "pdvo/test/support.h"
@@ -165,7 +166,7 @@ TEST(Synth, AnnotationNormalsAgreeWithNormalsFromDepth) {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
       Eigen::Vector3d n = eig.eigenvectors().col(0);
       if (n.dot(mean) > 0) n = -n;
-      const double angle = std::acos(std::clamp(n.dot(*shape.normal), -1.0, 1.0)) * 180 / M_PI;
+      const double angle = AngleDeg(n, *shape.normal);
       EXPECT_LT(angle, 1.0) << "frame " << i << " plane " << id;
       worst = std::max(worst, angle);
       EXPECT_LT(shape.normal->dot(mean), 0.0);  // towards the camera
