@@ -1,15 +1,16 @@
 #!/bin/bash
-# Every set a change to the odometry is judged on, in one table, with the same options for all: the walking streets
-# never used for tuning (101-124, ensembles of three runs a street), the driving streets (201-224, 600 frames), the
-# streets round a block (401-424, 600 frames, each starting in a corner), the driving streets through KITTI's camera
-# (301-312, 200 frames) and the real excerpts (bench/vo_real_ensemble.sh). A change that gains on one set and loses
-# on another shows here at once (docs/developing.md). About 30 minutes for the three modes on two cores.
+# Every set a change to the odometry is judged on, with the same options for all: the walking streets never used
+# for tuning (101-124, ensembles of three runs a street), the driving streets (201-224, 600 frames), the streets round
+# a block (401-424, 600 frames, each starting in a corner), the driving streets through KITTI's camera (301-312, 200
+# frames), each summarised per mode as vo_streets.sh does, and the real excerpts (vo_real_ensemble.sh's means). A
+# change that gains on one set and loses on another shows here at once (docs/developing.md). About 30 minutes for
+# the three modes on two cores.
 # Usage: bench/vo_sets.sh [option=value ...]   e.g. bench/vo_sets.sh features.max_misses=5
 # MODES="points idpp" runs fewer modes (default: points idpp pdvo); SETS="walking loop" fewer sets (default: walking
 # driving loop kitti_view real; the real excerpts always run the three modes).
 set -euo pipefail
 if [ "${1:-}" = "-h" ] || [ "${1:-}" = "--help" ]; then
-  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,9p'
+  sed -n 's/^# \{0,1\}//p' "$0" | sed -n '2,10p'
   exit 0
 fi
 here=$(dirname "$0")
@@ -21,18 +22,12 @@ trap 'rm -rf "$work"' EXIT
 sed 's/^\(\s*\)loop: false/\1loop: true/' "$here/../sim/config/default.yaml" >"$work/loop.yaml"
 grep -q '^\s*loop: true' "$work/loop.yaml" || { echo "vo_sets: cannot set loop in sim/config/default.yaml" >&2; exit 1; }
 
-streets() {  # NAME FRAMES FIRST LAST SYNTH SIGMAS
-  local name=$1 frames=$2 first=$3 last=$4 synth=$5 sigmas=$6 mode line
+streets() {  # NAME FRAMES FIRST LAST SYNTH SIGMAS, then the options: vo_streets.sh's summary per mode
+  local name=$1 frames=$2 first=$3 last=$4 synth=$5 sigmas=$6 mode
   shift 6
   for mode in "${modes[@]}"; do
-    line=$(FRAMES=$frames SIGMAS=$sigmas "$here/vo_streets.sh" "$first" "$last" ${synth:+synth=$synth} \
-      mode="$mode" "$@" | grep '^mean ')
-    # "mean 0.250% over 24 streets, ... (max 0.77%, ...), 0 above 1%; lost 0 times, 5 frames uncertain ..."
-    echo "$line" | awk -v set="$name $first-$last" -v mode="$mode" '{
-      gsub(/[(),;%]/, " "); mean = $2; for (i = 1; i < NF; i++) { if ($i == "max") max = $(i + 1)
-        if ($i == "above") above = $(i - 1); if ($i == "lost") lost = $(i + 1); if ($i == "frames") unc = $(i - 1) }
-      printf "%-22s %-7s mean ATE %7.3f%% of the path  largest %6.2f%%  above 1%%: %2d  lost %2d  uncertain frames %4d\n",
-        set, mode, mean, max, above, lost, unc }'
+    FRAMES=$frames SIGMAS=$sigmas "$here/vo_streets.sh" "$first" "$last" ${synth:+synth=$synth} mode="$mode" "$@" |
+      sed -n -e "s/^mean /$name $first-$last, $mode: mean /p" -e "s/^planes /$name $first-$last, $mode: planes /p"
   done
 }
 for set in "${sets[@]}"; do
