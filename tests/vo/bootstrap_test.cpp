@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "pdvo/common/geometry.h"
@@ -91,6 +92,30 @@ TEST(Bootstrap, TakesAGivenRotation) {
     free += AngleDeg(truth.translation, without.first_from_second.translation) / kDraws;
   }
   EXPECT_LT(given, 0.5 * free) << "direction error, degrees: " << given << " given the rotation, " << free << " not";
+}
+
+// Given the rotation, the direction is fitted to the essential matrix's RANSAC inliers only: with a third of the
+// correspondences moved to random pixels and the rest with 0.3 px noise, it keeps the true ones, leaves out the
+// moved ones, and finds the direction within a degree.
+TEST(Bootstrap, GivenTheRotationLeavesOutGrossMismatches) {
+  const Rigid3d truth(Eigen::Quaterniond(Eigen::AngleAxisd(6 * M_PI / 180, Eigen::Vector3d::UnitY())),
+                      Eigen::Vector3d(0.4, 0.05, 0.6));
+  TwoViews v = Generate(truth, 150, 11);
+  std::mt19937 rng(12);
+  std::normal_distribution<float> noise(0, 0.3);
+  std::uniform_real_distribution<float> x(0, 319), y(0, 239);
+  std::vector<bool> moved(v.second.size());
+  for (size_t i = 0; i < v.second.size(); ++i) {
+    moved[i] = i % 3 == 0;
+    v.second[i] = moved[i] ? cv::Point2f(x(rng), y(rng)) : v.second[i] + cv::Point2f(noise(rng), noise(rng));
+  }
+  TwoViewMotion motion;
+  ASSERT_TRUE(EstimateTwoView(kCamera, v.first, v.second, 1.5, 0.2, &motion, truth.rotation));
+  EXPECT_LT(AngleDeg(truth.translation, motion.first_from_second.translation), 1.0);
+  const long kept_moved = std::count_if(motion.inliers.begin(), motion.inliers.end(), [&](int i) { return moved[i]; });
+  // A moved correspondence can fall near its epipolar line by chance: about 2 px of a 320 px line's neighbourhood.
+  EXPECT_LE(kept_moved, 5);
+  EXPECT_GE(static_cast<long>(motion.inliers.size()) - kept_moved, 90);  // of the 100 true ones
 }
 
 // Refused with the essential matrix's own rotation and with the true one given (as the odometry gives the filter's).

@@ -37,7 +37,7 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// The median angle (rad) between the bearings `second` and those of `first` turned by the rotation that best
+// The median angle (degrees) between the bearings `second` and those of `first` turned by the rotation that best
 // maps the one onto the other (least squares): the parallax that no pure rotation explains. A camera that only
 // turns has none, however its essential matrix decomposes.
 double MedianUnexplainedByRotation(const std::vector<Eigen::Vector3d>& first,
@@ -50,7 +50,7 @@ double MedianUnexplainedByRotation(const std::vector<Eigen::Vector3d>& first,
   const Eigen::Matrix3d rotation = svd.matrixU() * d * svd.matrixV().transpose();
   std::vector<double> angles;
   for (size_t i = 0; i < first.size(); ++i)
-    angles.push_back(std::acos(std::clamp(second[i].dot(rotation * first[i]), -1.0, 1.0)));
+    angles.push_back(AngleDeg(second[i], rotation * first[i]));
   return Median(angles);
 }
 
@@ -63,8 +63,8 @@ cv::Mat EssentialGivenRotation(const Camera& camera, const std::vector<cv::Point
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (size_t i = 0; i < from.size(); ++i) {
     if (!inliers.at<uchar>(static_cast<int>(i))) continue;
-    const Eigen::Vector3d first = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).normalized();
-    const Eigen::Vector3d second = camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized();
+    const Eigen::Vector3d first = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y));
+    const Eigen::Vector3d second = camera.Ray(Eigen::Vector2d(to[i].x, to[i].y));
     const Eigen::Vector3d normal = (rotation * first).cross(second);
     scatter += normal * normal.transpose();
   }
@@ -112,21 +112,20 @@ bool EstimateTwoView(const Camera& camera, const std::vector<cv::Point2f>& from,
     const Eigen::Vector3d x = h.hnormalized();
     const Eigen::Vector3d in_second = rotation * x + translation;
     if (x.z() <= 0 || in_second.z() <= 0) continue;
-    parallax.push_back(std::acos(std::clamp(x.normalized().dot((x - centre).normalized()), -1.0, 1.0)));
+    parallax.push_back(AngleDeg(x, x - centre));
     distance.push_back(in_second.norm());
     motion->inliers.push_back(i);
     motion->points.push_back(x);
-    bearings_first.push_back(camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).normalized());
-    bearings_second.push_back(camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized());
+    bearings_first.push_back(camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)));
+    bearings_second.push_back(camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)));
   }
   const size_t n = motion->inliers.size();
   if (n < kBootstrapInliers) return false;
   motion->found = true;
   motion->first_from_second = Rigid3d(Eigen::Quaterniond(rotation.transpose()), centre);
   if (2 * n < to.size()) return false;
-  if (Median(parallax) < parallax_deg * M_PI / 180) return false;
-  if (MedianUnexplainedByRotation(bearings_first, bearings_second) < kMinUnexplainedShare * parallax_deg * M_PI / 180)
-    return false;
+  if (Median(parallax) < parallax_deg) return false;
+  if (MedianUnexplainedByRotation(bearings_first, bearings_second) < kMinUnexplainedShare * parallax_deg) return false;
   const double scale = 1 / (inverse_depth * Median(distance));
   for (Eigen::Vector3d& x : motion->points) x *= scale;
   motion->first_from_second.translation *= scale;
@@ -162,8 +161,8 @@ std::optional<double> EpipolarDisagreement(const Camera& camera, const cv::Mat& 
   std::vector<double> angles;
   for (int i = 0; i < inliers.rows; ++i) {
     if (!inliers.at<uchar>(i)) continue;
-    const Eigen::Vector3d b1 = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y)).normalized();
-    const Eigen::Vector3d b2 = rotation * camera.Ray(Eigen::Vector2d(to[i].x, to[i].y)).normalized();
+    const Eigen::Vector3d b1 = camera.Ray(Eigen::Vector2d(from[i].x, from[i].y));
+    const Eigen::Vector3d b2 = rotation * camera.Ray(Eigen::Vector2d(to[i].x, to[i].y));
     const Eigen::Vector3d normal = baseline.cross(b1);  // of the epipolar plane, in the first view's frame
     angles.push_back(normal.norm() > 1e-12 * baseline.norm() && baseline.norm() > 0
                          ? std::asin(std::min(1.0, std::abs(normal.normalized().dot(b2))))
@@ -224,8 +223,7 @@ std::optional<BootstrapStart> TwoViewBootstrap::Step(const cv::Mat& grey, double
   // Its direction must agree with the motion found a frame before (kMaxDirectionChange).
   const std::optional<Eigen::Vector3d> before = std::exchange(last_direction_, std::nullopt);
   if (motion.found) last_direction_ = motion.first_from_second.translation.normalized();
-  if (!enough || !before ||
-      std::acos(std::clamp(before->dot(*last_direction_), -1.0, 1.0)) > kMaxDirectionChange * M_PI / 180) {
+  if (!enough || !before || AngleDeg(*before, *last_direction_) > kMaxDirectionChange) {
     return std::nullopt;
   }
   const Rigid3d& first_from_current = motion.first_from_second;
