@@ -49,8 +49,7 @@ double MedianUnexplainedByRotation(const std::vector<Eigen::Vector3d>& first,
   d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1 : 1;
   const Eigen::Matrix3d rotation = svd.matrixU() * d * svd.matrixV().transpose();
   std::vector<double> angles;
-  for (size_t i = 0; i < first.size(); ++i)
-    angles.push_back(AngleDeg(second[i], rotation * first[i]));
+  for (size_t i = 0; i < first.size(); ++i) angles.push_back(AngleDeg(second[i], rotation * first[i]));
   return Median(angles);
 }
 
