@@ -16,11 +16,6 @@ fi
 here=$(dirname "$0")
 read -ra modes <<<"${MODES:-points idpp pdvo}"
 read -ra sets <<<"${SETS:-walking driving loop kitti_view real}"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-# The round-a-block streets: the default street with loop set (the demo's kind).
-sed 's/^\(\s*\)loop: false/\1loop: true/' "$here/../sim/config/default.yaml" >"$work/loop.yaml"
-grep -q '^\s*loop: true' "$work/loop.yaml" || { echo "vo_sets: cannot set loop in sim/config/default.yaml" >&2; exit 1; }
 
 streets() {  # NAME FRAMES FIRST LAST SYNTH SIGMAS, then the options: vo_streets.sh's summary per mode
   local name=$1 frames=$2 first=$3 last=$4 synth=$5 sigmas=$6 mode
@@ -34,7 +29,7 @@ for set in "${sets[@]}"; do
   case $set in
     walking) streets walking 1000 101 124 "" "0.49 0.5 0.51" "$@" ;;
     driving) streets driving 600 201 224 sim/config/driving.yaml "" "$@" ;;
-    loop) streets "round a block" 600 401 424 "$work/loop.yaml" "" "$@" ;;
+    loop) streets "round a block" 600 401 424 sim/config/loop.yaml "" "$@" ;;
     kitti_view) streets "KITTI view" 200 301 312 sim/config/driving_kitti.yaml "" "$@" ;;
     real) "$here/vo_real_ensemble.sh" "${PDVO_DATA:-../shared/data}" "$@" | grep '^mean' ;;
     *) echo "vo_sets: unknown set $set (walking, driving, loop, kitti_view, real)" >&2; exit 2 ;;

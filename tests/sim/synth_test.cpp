@@ -374,6 +374,14 @@ TEST(Synth, DrivingConfigDrivesACar) {
   EXPECT_LT(o.walk.lateral_offset, o.street.road_width / 2);
 }
 
+// The streets round a block are the default street closed into a loop, nothing else changed.
+TEST(Synth, LoopConfigIsTheDefaultStreetClosed) {
+  SynthOptions loop = LoadOptions<SynthOptions>(PDVO_SOURCE_DIR "/sim/config/loop.yaml", "synth");
+  EXPECT_TRUE(loop.street.loop);
+  loop.street.loop = SynthOptions().street.loop;
+  EXPECT_EQ(loop, SynthOptions());
+}
+
 // The KITTI-view driving set is the driving set seen through KITTI's camera reduced to 320 px: the same street and
 // drive (its other options repeat driving.yaml's and must not drift from them), 320x97 pixels and fx 184.6 px.
 TEST(Synth, KittiViewConfigIsTheDrivingSetThroughKittisCamera) {

@@ -164,11 +164,11 @@ std::optional<double> EpipolarDisagreement(const Camera& camera, const cv::Mat& 
     const Eigen::Vector3d b2 = rotation * camera.Ray(Eigen::Vector2d(to[i].x, to[i].y));
     const Eigen::Vector3d normal = baseline.cross(b1);  // of the epipolar plane, in the first view's frame
     angles.push_back(normal.norm() > 1e-12 * baseline.norm() && baseline.norm() > 0
-                         ? std::asin(std::min(1.0, std::abs(normal.normalized().dot(b2))))
-                         : std::acos(std::clamp(b1.dot(b2), -1.0, 1.0)));
+                         ? std::asin(std::min(1.0, std::abs(normal.normalized().dot(b2)))) * 180 / M_PI
+                         : AngleDeg(b1, b2));
   }
   if (angles.size() < kBootstrapInliers || 2 * angles.size() < kept) return std::nullopt;
-  return Median(angles) * 180 / M_PI;
+  return Median(angles);
 }
 
 TwoViewBootstrap::TwoViewBootstrap(const Camera& camera, const BootstrapOptions& options, int border,
