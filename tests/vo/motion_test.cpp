@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <random>
+#include <vector>
 
 namespace pdvo::vo {
 namespace {
@@ -59,22 +61,47 @@ TEST(Motion, JacobiansMatchCentralDifferences) {
   }
 }
 
-TEST(Motion, ConstantVelocityFollowsTheClosedForm) {
+// At constant rates the velocity keeps its direction in the camera frame, so a camera driving forward while it
+// turns about its vertical axis runs round a circle: each step a chord of |v| dt, turning by w dt, the vertices
+// of a regular polygon of circumradius |v| dt / (2 sin(w dt / 2)).
+TEST(Motion, ConstantRatesDriveACircle) {
   std::mt19937 rng(3);
   CameraState s = RandomState(rng);
+  const Eigen::Matrix3d r0 = s.orientation.toRotationMatrix();
+  s.velocity = r0 * Eigen::Vector3d(0.3, 0, 10);    // forward, drifting sideways: m/s, camera frame
+  s.angular_velocity = Eigen::Vector3d(0, 0.5, 0);  // rad/s about the camera's vertical axis
   const CameraState start = s;
-  const double dt = 1.0 / 30;
-  for (int k = 0; k < 30; ++k) s = PredictCamera(s, dt);
-  EXPECT_LT((s.position - (start.position + start.velocity)).norm(), 1e-12);
-  EXPECT_LT(AngularDistance(s.orientation, start.orientation * ExpSO3(start.angular_velocity)), 1e-10);
-  EXPECT_EQ(s.velocity, start.velocity);
+  const double dt = 0.1;
+  const int steps = 40;
+  std::vector<Eigen::Vector3d> positions{s.position};
+  for (int k = 0; k < steps; ++k) {
+    s = PredictCamera(s, dt);
+    positions.push_back(s.position);
+  }
+  EXPECT_LT(AngularDistance(s.orientation, start.orientation * ExpSO3(steps * dt * start.angular_velocity)), 1e-10);
+  EXPECT_LT((s.orientation.conjugate() * s.velocity - start.orientation.conjugate() * start.velocity).norm(), 1e-10);
   EXPECT_EQ(s.angular_velocity, start.angular_velocity);
+  // The circle's centre: the point equidistant from the first three positions, in their plane.
+  const double chord = start.velocity.norm() * dt, turn = start.angular_velocity.norm() * dt;
+  const double radius = chord / (2 * std::sin(turn / 2));
+  const Eigen::Vector3d a = positions[0], b = positions[1], c = positions[2];
+  const Eigen::Vector3d normal = (b - a).cross(c - a);
+  const Eigen::Vector3d centre =
+      a + ((c - a).squaredNorm() * normal.cross(b - a) + (b - a).squaredNorm() * (c - a).cross(normal)) /
+              (2 * normal.squaredNorm());
+  for (const Eigen::Vector3d& p : positions) {
+    EXPECT_NEAR((p - centre).norm(), radius, 1e-9 * radius);
+    EXPECT_NEAR((p - a).dot(normal.normalized()), 0, 1e-9 * radius);  // in one plane, the camera's horizontal
+  }
+  EXPECT_NEAR(std::abs(normal.normalized().dot(start.orientation * Eigen::Vector3d::UnitY())), 1, 1e-12);
 }
 
 TEST(Motion, ProcessNoiseIsSymmetricPositiveSemidefiniteAndScales) {
   std::mt19937 rng(4);
   Eigen::Matrix<double, 12, 6> g;
-  PredictCamera(RandomState(rng), 0.05, nullptr, &g);
+  CameraState at_rest = RandomState(rng);
+  at_rest.velocity.setZero();  // else the angular noise turns the velocity too
+  PredictCamera(at_rest, 0.05, nullptr, &g);
   const Matrix12d q = ProcessNoise(g, 0.05, 2.0, 3.0);
   EXPECT_LT((q - q.transpose()).cwiseAbs().maxCoeff(), 1e-15);
   const Eigen::SelfAdjointEigenSolver<Matrix12d> eigen(q);

@@ -1,6 +1,8 @@
 // The camera of the EKF (the paper's section IV, after Davison's MonoSLAM): position and orientation in the
 // world, linear velocity (world frame) and angular velocity (camera frame), under a constant-velocity model
-// driven by random accelerations. The filter works on a 12-D error state
+// driven by random accelerations, whose velocity turns with the camera (constant in the camera frame: a car keeps
+// driving forward through a corner, where a velocity constant in the world would carry it straight on). The filter
+// works on a 12-D error state
 //   (dp, dtheta, dv, dw):  p + dp,  q * Exp(dtheta) (rotation perturbed on the right, in the camera frame),
 //                          v + dv,  w + dw.
 #pragma once
@@ -54,7 +56,7 @@ struct CameraState {
 };
 
 // Constant velocity over dt seconds, the velocities taking random impulses V = a dt and W = alpha dt first:
-//   p' = p + (v + V) dt,  q' = q Exp((w + W) dt),  v' = v + V,  w' = w + W.
+//   p' = p + (v + V) dt,  q' = q Exp((w + W) dt),  v' = q' q^-1 (v + V),  w' = w + W.
 // With `f` and `g`, the Jacobians of the error state after the step with respect to the error state before it
 // (12x12) and to the impulses (V, W) (12x6), at zero impulse.
 CameraState PredictCamera(const CameraState& state, double dt, Matrix12d* f = nullptr,
