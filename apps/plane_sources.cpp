@@ -40,7 +40,7 @@ PlaneSource::PlaneSource(const std::string& source, const std::string& model_pat
     : impl_(std::make_unique<Impl>()) {
   impl_->working = working;
   if (source == "model") {
-    impl_->detector = std::make_unique<Detector>(PlaneModel::Read(model_path), DetectorOptions::ForOdometry());
+    impl_->detector = std::make_unique<Detector>(PlaneModel::Read(model_path), DetectorOptions());
     impl_->description = "the detector with " + model_path;
   } else if (source == "oracle") {
     const fs::path folder = fs::path(sequence_path) / "annotations";

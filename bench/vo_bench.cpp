@@ -125,8 +125,7 @@ int main(int argc, char** argv) {
   pdvo::vo::PlaneDetector detect;
   std::unique_ptr<pdvo::Detector> detector;
   if (pdvo_mode && source == "model") {
-    detector =
-        std::make_unique<pdvo::Detector>(pdvo::PlaneModel::Read(model_path), pdvo::DetectorOptions::ForOdometry());
+    detector = std::make_unique<pdvo::Detector>(pdvo::PlaneModel::Read(model_path), pdvo::DetectorOptions());
     detect = [&](const pdvo::vo::KeyframeImage& k) {
       return detector->Detect(k.colour, working).Planes(working.width, working.height);
     };

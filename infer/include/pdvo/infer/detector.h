@@ -94,18 +94,6 @@ struct DetectorOptions {
   }
   bool Check() const;
   bool operator==(const DetectorOptions&) const = default;
-  // What PDVO's detector runs with: the defaults with a colour split ten times as reluctant, that cuts a facade only
-  // where its colour changes strongly, and no cut where its edges turn. The default colour split makes PDVO seed
-  // more and smaller planes; none makes them span neighbouring facades more often (docs/pdvo.md; 2026-12-06, 27
-  // streets: purity 0.769 -> 0.802, points per plane 14.85 -> 13.48 against IDPP's 7.65). The turn's cut makes
-  // them purer but smaller (purity 0.840, area 1.76 times IDPP's, under the 1.8 asked; at ten times its price
-  // purity 0.798 and ATE 0.356% against 0.323: docs/experiments/2026-12-06-facade-turns.md).
-  static DetectorOptions ForOdometry() {
-    DetectorOptions o;
-    o.column_split_penalty = 10 * o.column_split_penalty;
-    o.azimuth_split_penalty = 0;
-    return o;
-  }
 };
 
 struct DetectedWindow {
