@@ -352,7 +352,9 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     return mask;
   };
   // A plane segment of these points and this area, recognised again (its final normal and score), or none if the
-  // recognition rejects it (without re-recognition: its points' robust mean normal and mean planarity).
+  // recognition rejects it (without re-recognition: its points' robust mean normal and mean planarity). Where the
+  // points' mean normal is horizontal and the recognition's is not, the mean is kept: a wide stretch of road and
+  // pavement is recognised less surely than by the windows over its parts (docs/detector.md).
   auto plane_of = [&](const std::vector<int>& members, cv::Mat mask) -> std::optional<DetectedSegment> {
     DetectedSegment s;
     s.planar = true;
@@ -360,21 +362,24 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     s.mask = std::move(mask);
     const cv::Rect box = cv::boundingRect(s.mask);
     if (box.area() == 0) return std::nullopt;
-    if (o.rerecognise) {
-      const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
-      if (!p.valid || p.plane_probability < o.min_plane_probability) return std::nullopt;
-      s.normal = p.normal;
-      s.score = p.plane_probability;
-      return s;
-    }
     std::vector<Eigen::Vector3d> member_normals;
     std::vector<double> member_weights;
     for (const int i : members) {
       member_normals.push_back(d.normals[i]);
       member_weights.push_back(d.planarity[i]);
-      s.score += d.planarity[i] / static_cast<double>(members.size());
     }
-    s.normal = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    const Eigen::Vector3d mean = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    if (!o.rerecognise) {
+      for (const int i : members) s.score += d.planarity[i] / static_cast<double>(members.size());
+      s.normal = mean;
+      return s;
+    }
+    const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
+    if (!p.valid || p.plane_probability < o.min_plane_probability) return std::nullopt;
+    const double horizontal = model.options.vanishing.horizontal_cos;
+    const bool ground = std::abs(mean.dot(words.edges.up)) > horizontal;
+    s.normal = ground && std::abs(p.normal.dot(words.edges.up)) < horizontal ? mean : p.normal;
+    s.score = p.plane_probability;
     return s;
   };
   cv::Mat lab;

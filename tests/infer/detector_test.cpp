@@ -81,11 +81,15 @@ struct StreetFrame {
   Camera camera;
 };
 
-StreetFrame RenderStreet(uint64_t seed, int frame) {
+// Frame `frame` of `pdvo synth -n 15 --seed SEED --set walk.fps=1 --set walk.look_deg=LOOK`.
+StreetFrame RenderStreet(uint64_t seed, int frame, double look_deg = 0) {
   sim::SynthOptions options;
   options.walk.fps = 1;
-  const sim::Street street = sim::GenerateStreet(options.street, 60, seed);
-  const Trajectory walk = sim::WalkStreet(street, options.walk, frame + 1, seed);
+  options.walk.look_deg = look_deg;
+  const int frames = 15;
+  const sim::Street street =
+      sim::GenerateStreet(options.street, options.walk.speed * frames / options.walk.fps + 30.0, seed);
+  const Trajectory walk = sim::WalkStreet(street, options.walk, frames, seed);
   StreetFrame s;
   s.camera = options.MakeCamera();
   const sim::Renderer renderer(street, s.camera, options.render, seed);
@@ -107,7 +111,7 @@ double Iou(const cv::Mat& a, const cv::Mat& b) {
 }
 
 // On a street the model never saw (seed 951), at least half the true planes covering 10% of the frame or more are
-// found: a detected plane overlaps each with IoU >= 0.4 and a normal within 30 degrees (measured: 5 of 7).
+// found: a detected plane overlaps each with IoU >= 0.4 and a normal within 30 degrees (measured 2026-12-07: 7 of 7).
 TEST(Detector, FindsTheLargePlanesOfARenderedStreet) {
   int large = 0, found = 0;
   for (const int frame : {3, 9, 14}) {
@@ -133,6 +137,25 @@ TEST(Detector, FindsTheLargePlanesOfARenderedStreet) {
   ASSERT_GT(large, 3);
   EXPECT_GE(found, large / 2) << found << " of " << large << " large planes found";
   RecordProperty("large_planes_found", std::to_string(found) + " of " + std::to_string(large));
+}
+
+// A wide stretch of road and pavement beside a facade, which the recogniser, seeing it whole, takes for a wall 88
+// degrees off (validation street 605, frame 2): the windows over its parts call it horizontal, and so does the
+// detection (measured: IoU 0.70, 14 degrees off, the windows' mean).
+TEST(Detector, KeepsTheGroundHorizontalWhereItsRecognitionSaysWall) {
+  const StreetFrame s = RenderStreet(605, 2, 60);
+  const Detections d = DefaultDetector().Detect(s.image, s.camera);
+  const Annotation detected = d.ToAnnotation("frame.png", s.image.cols, s.image.rows, s.camera);
+  double best = 0;
+  for (const AnnotationShape& truth : s.truth.shapes) {
+    if (!truth.IsPlane() || std::abs(truth.normal->y()) < 0.9) continue;  // the ground (y is down)
+    const cv::Mat t = RasteriseShape(truth, s.truth);
+    for (const AnnotationShape& shape : detected.shapes) {
+      if (shape.IsPlane() && AngleDeg(*shape.normal, *truth.normal) <= 30)
+        best = std::max(best, Iou(RasteriseShape(shape, detected), t));
+    }
+  }
+  EXPECT_GE(best, 0.5) << "the ground's best match within 30 degrees";
 }
 
 TEST(Detector, TheSameImageGivesTheSameBytesFromAnyThread) {
