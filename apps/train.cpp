@@ -1,4 +1,5 @@
-// pdvo train --annotations DIR... --out MODEL: trains the plane recogniser into one versioned model file.
+// pdvo train --annotations DIR... --out MODEL: trains the plane recogniser into one versioned model file (or, with
+// --word-prior-of, adds the words' plane log-odds to a model trained before them).
 #include <sys/resource.h>
 
 #include <sstream>
@@ -19,7 +20,7 @@ int RunTrain(int argc, char** argv) {
       "Writes one model file (YAML) holding everything inference needs and a training card.",
       "pdvo train");
   std::vector<std::string> inputs, overrides;
-  std::string out_path, config_path, verbosity = "info", classifier;
+  std::string out_path, config_path, verbosity = "info", classifier, prior_of;
   uint64_t seed = 1;
   int folds = 3;
   app.add_option("--annotations,-a", inputs, "Folders (or files) of annotations; give several")->required();
@@ -36,15 +37,31 @@ int RunTrain(int argc, char** argv) {
   app.add_option("--cv", folds, "Cross-validation folds (grouped by image) to choose kernel widths; 1: none")
       ->capture_default_str()
       ->check(CLI::Range(1, 20));
+  app.add_option("--word-prior-of", prior_of,
+                 "Instead of training: a copy of this model (its classifiers unchanged) with each word's plane "
+                 "log-odds counted over the annotations, the plane detector's words' prior (models before version 6)")
+      ->check(CLI::ExistingFile);
   AddVerbosityFlag(app, &verbosity);
   PDVO_PARSE_FLAGS(app, argc, argv);
   ApplyVerbosity(verbosity);
+  std::ostringstream data;
+  for (size_t i = 0; i < inputs.size(); ++i) data << (i ? " " : "") << inputs[i];
+  if (!prior_of.empty()) {
+    PlaneModel model = PlaneModel::Read(prior_of);
+    const std::vector<std::string> files = ListAnnotationFiles(inputs);
+    model.word_plane_log_odds = CountWordPlaneLogOdds(model, files);
+    model.card.word_prior =
+        data.str() + " (" + std::to_string(files.size()) + " files; pdvo " + kVersion + ", " + kGitHash + ")";
+    model.Write(out_path);
+    std::printf("wrote %s: %s with its words' plane log-odds from %zu annotation files (from %.2f to %.2f)\n",
+                out_path.c_str(), prior_of.c_str(), files.size(), model.word_plane_log_odds.minCoeff(),
+                model.word_plane_log_odds.maxCoeff());
+    return 0;
+  }
 
   if (!classifier.empty()) overrides.push_back("classifier=" + classifier);
   const TrainOptions options = LoadToolOptions<TrainOptions>(config_path, "train", overrides);
   const std::vector<std::string> files = ListAnnotationFiles(inputs);
-  std::ostringstream data;
-  for (size_t i = 0; i < inputs.size(); ++i) data << (i ? " " : "") << inputs[i];
   PDVO_LOG(Info) << "training on " << files.size() << " annotation files";
   PlaneModel model = TrainModel(files, options, seed, folds, data.str());
   std::vector<std::string> assignments;

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
 #include "pdvo/infer/column_cuts.h"
 #include "pdvo/infer/mrf.h"
@@ -24,6 +25,7 @@ namespace {
 constexpr double kDegree = M_PI / 180;
 constexpr double kMinProbability = 1e-3;   // MRF 1's data terms: -log of probabilities clamped to this
 constexpr double kMaxOrientationCost = 4;  // MRF 2's data cost, at most
+constexpr double kMaxWordLogOdds = 3;      // a point's two words' plane log-odds, summed, at most this either way
 constexpr int kMinColumnPixels = 8;        // a column of a plane's area with fewer pixels has no colour of its own
 constexpr int kMinPartPoints = 3;          // a part of a split plane is kept down to this many points
 
@@ -172,7 +174,7 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(cell >= 1 && !window_sizes.empty() && !window_aspects.empty());
   for (const double s : window_sizes) PDVO_CHECK_OPTION(s >= cell);
   for (const double a : window_aspects) PDVO_CHECK_OPTION(a > 0 && a <= 16 && a >= 1.0 / 16);
-  PDVO_CHECK_OPTION(overlap >= 0 && overlap < 1 && normal_scale_deg > 0);
+  PDVO_CHECK_OPTION(overlap >= 0 && overlap < 1 && normal_scale_deg > 0 && word_prior_weight >= 0);
   PDVO_CHECK_OPTION(distance_scale > 0 && colour_scale > 0 && plane_smoothness >= 0);
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
@@ -186,6 +188,10 @@ bool DetectorOptions::Check() const {
 Detector::Detector(PlaneModel model, const DetectorOptions& options)
     : recogniser_(std::move(model)), options_(options) {
   CheckOptionsOrThrow(options, "detector options");
+  if (options.word_prior_weight > 0 && recogniser_.model().word_plane_log_odds.size() == 0) {
+    PDVO_LOG(Warning) << "the model has no word log-odds (trained before version 6): the detector runs without its "
+                         "words' prior (pdvo train --word-prior-of adds them)";
+  }
 }
 
 Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& camera) const {
@@ -238,6 +244,18 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   PointPooling pooled = PoolWindows(d.points, d.windows, o.normal_scale_deg);
   d.planarity = std::move(pooled.planarity);
   d.normals = std::move(pooled.normals);
+  // The prior of the points' words (version 6 models): trees, cars and sky have words of their own, which windows
+  // that mostly see facades outvote.
+  const Eigen::VectorXd& word_odds = model.word_plane_log_odds;
+  if (o.word_prior_weight > 0 && word_odds.size() > 0) {
+    const Eigen::Index colour_offset = word_odds.size() - model.colour_words.size();
+    for (int i = 0; i < n; ++i) {
+      const double words_say = std::clamp(word_odds(words.gradient[i]) + word_odds(colour_offset + words.colour[i]),
+                                          -kMaxWordLogOdds, kMaxWordLogOdds);
+      const double p = std::clamp(d.planarity[i], kMinProbability, 1 - kMinProbability);
+      d.planarity[i] = 1 / (1 + std::exp(-std::log(p / (1 - p)) - o.word_prior_weight * words_say));
+    }
+  }
   d.times.pooling = Ms(t);
 
   // 3. The graph and the two MRFs.

@@ -152,8 +152,8 @@ PlaneModel ParseModel(const std::string& text, const std::string& where) {
   PDVO_THROW_CHECK(static_cast<std::string>(fs["format"]) == kModelFormat, FormatError,
                    where << ": not a " << kModelFormat << " file");
   const int version = static_cast<int>(fs["version"]);
-  PDVO_THROW_CHECK(version == kModelVersion || version == 3, FormatError,
-                   where << ": model version " << version << ", this build reads versions 3 and " << kModelVersion
+  PDVO_THROW_CHECK(version >= 3 && version <= kModelVersion, FormatError,
+                   where << ": model version " << version << ", this build reads versions 3 to " << kModelVersion
                          << " (retrain with pdvo train)");
   PDVO_THROW_CHECK(checked || version < 5, FormatError,
                    where << ": no checksum line (a version " << version << " model ends with '" << kChecksumPrefix
@@ -191,6 +191,7 @@ PlaneModel ParseModel(const std::string& text, const std::string& where) {
   m.card.training_options = static_cast<std::string>(card["training_options"]);
   m.card.pdvo_version = static_cast<std::string>(card["pdvo_version"]);
   m.card.git_commit = static_cast<std::string>(card["git_commit"]);
+  m.card.word_prior = static_cast<std::string>(card["word_prior"]);
   m.gradient_words = Vocabulary::Read(fs["gradient_words"], where + ": gradient_words");
   m.colour_words = Vocabulary::Read(fs["colour_words"], where + ": colour_words");
   PDVO_THROW_CHECK(m.gradient_words.dims() == kGradientDims && m.colour_words.dims() == kColourDims, FormatError,
@@ -198,6 +199,11 @@ PlaneModel ParseModel(const std::string& text, const std::string& where) {
   m.topics = ReadMatrix(fs.root(), where, "topics");
   PDVO_THROW_CHECK(m.topics.rows() == m.gradient_words.size() + m.colour_words.size() && (m.topics.array() >= 0).all(),
                    FormatError, where << ": the topic basis does not match the vocabularies");
+  if (!fs["word_plane_log_odds"].empty()) {  // version 6 models trained since it was added
+    m.word_plane_log_odds = ReadMatrix(fs.root(), where, "word_plane_log_odds");
+    PDVO_THROW_CHECK(m.word_plane_log_odds.size() == m.topics.rows() && m.word_plane_log_odds.allFinite(), FormatError,
+                     where << ": the word log-odds do not match the vocabularies");
+  }
   m.feature_mean = ReadMatrix(fs.root(), where, "feature_mean");
   m.feature_scale = ReadMatrix(fs.root(), where, "feature_scale");
   const int dims = static_cast<int>(m.feature_mean.rows());
@@ -363,10 +369,14 @@ std::string PlaneModel::ToYaml() const {
      << "data" << card.data << "images" << card.images << "plane_regions" << card.plane_regions << "non_plane_regions"
      << card.non_plane_regions << "normal_regions" << card.normal_regions << "folds" << card.folds << "cv_accuracy"
      << card.cv_accuracy << "cv_normal_error_deg" << card.cv_normal_error << "seed" << card.seed << "training_options"
-     << card.training_options << "pdvo_version" << card.pdvo_version << "git_commit" << card.git_commit << "}";
+     << card.training_options << "pdvo_version" << card.pdvo_version << "git_commit" << card.git_commit;
+  if (!card.word_prior.empty()) fs << "word_prior" << card.word_prior;
+  fs << "}";
   gradient_words.Write(fs, "gradient_words");
   colour_words.Write(fs, "colour_words");
-  fs << "topics" << ToMat(topics) << "feature_mean" << ToMat(feature_mean) << "feature_scale" << ToMat(feature_scale);
+  fs << "topics" << ToMat(topics);
+  if (word_plane_log_odds.size() > 0) fs << "word_plane_log_odds" << ToMat(word_plane_log_odds);
+  fs << "feature_mean" << ToMat(feature_mean) << "feature_scale" << ToMat(feature_scale);
   fs << "classifiers"
      << "[";
   for (const Learned& f : classifiers) WriteLearned(fs, "", f);
@@ -385,6 +395,19 @@ PlaneModel PlaneModel::FromYaml(const std::string& text, const std::string& wher
 void PlaneModel::Write(const std::string& path) const { WriteFileAtomically(path, ToYaml()); }
 
 PlaneModel PlaneModel::Read(const std::string& path) { return FromYaml(ReadFile(path), path); }
+
+Eigen::VectorXd WordPlaneLogOdds(const Eigen::VectorXd& plane_counts, const Eigen::VectorXd& non_plane_counts) {
+  PDVO_THROW_CHECK(plane_counts.size() == non_plane_counts.size() && plane_counts.minCoeff() >= 0 &&
+                       non_plane_counts.minCoeff() >= 0,
+                   InvalidArgument, "word log-odds: counts of different sizes or negative");
+  const double planes = plane_counts.sum(), non_planes = non_plane_counts.sum();
+  PDVO_THROW_CHECK(planes > 0 && non_planes > 0, InvalidArgument,
+                   "word log-odds: no salient points on annotated planes or on annotated non-planes");
+  const double share = planes / (planes + non_planes);
+  const Eigen::ArrayXd plane = plane_counts.array() + kWordPriorCounts * share;
+  const Eigen::ArrayXd non_plane = non_plane_counts.array() + kWordPriorCounts * (1 - share);
+  return ((plane / non_plane).log() - std::log(share / (1 - share))).matrix();
+}
 
 std::string SealModelText(std::string text) {
   if (text.substr(LastLineStart(text)).starts_with(kChecksumPrefix)) text.resize(LastLineStart(text));

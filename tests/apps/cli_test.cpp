@@ -355,6 +355,21 @@ TEST(Cli, TrainAndEvaluateOnGeneratedStreets) {
     const RvmFunction &a = model.classifiers[0].rvm, &b = model.classifiers[i].rvm;
     EXPECT_FALSE(a.size() == b.size() && a.vectors == b.vectors) << "classifiers 0 and " << i << " are the same";
   }
+  // Each word's plane log-odds, counted over the training points: some words lean to planes, some (leaves, sky) away.
+  ASSERT_EQ(model.word_plane_log_odds.size(), 60 + 16);
+  EXPECT_LT(model.word_plane_log_odds.minCoeff(), -1);
+  EXPECT_GT(model.word_plane_log_odds.maxCoeff(), 0.1);
+  // Counted again for the trained model (as for a model trained before them): the same log-odds, the classifiers
+  // untouched, and the card says where they came from.
+  const CommandResult prior = Pdvo("train --word-prior-of " + (dir / "m.yml") + " -a " + (dir / "train/annotations") +
+                                       " -o " + (dir / "m3.yml") + " -v warning",
+                                   dir);
+  ASSERT_EQ(prior.code, 0) << prior.err;
+  const PlaneModel recounted = PlaneModel::Read(dir / "m3.yml");
+  EXPECT_TRUE(recounted.word_plane_log_odds.isApprox(model.word_plane_log_odds, 1e-12));
+  EXPECT_EQ(recounted.classifiers[0].rvm.vectors, model.classifiers[0].rvm.vectors);
+  EXPECT_NE(recounted.card.word_prior.find("train/annotations (40 files; pdvo "), std::string::npos)
+      << recounted.card.word_prior;
 
   const CommandResult e = Pdvo("evaluate -m " + (dir / "m.yml") + " -a " + (dir / "test/annotations") + " --json " +
                                    (dir / "report.json") + " -v warning",

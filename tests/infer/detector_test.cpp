@@ -1,7 +1,7 @@
-// The plane detector: pooling on hand-made windows and against the direct computation; an end-to-end detection on a
-// rendered street whose planes are known (its largest planes found, with their orientation); the same image gives the
-// same annotation bytes, from one thread or two at once; images too small or empty are refused; the shipped options
-// file equals the defaults.
+// The plane detector: pooling on hand-made windows and against the direct computation; the words' prior; an end-to-end
+// detection on a rendered street whose planes are known (its largest planes found, with their orientation); the same
+// image gives the same annotation bytes, from one thread or two at once; images too small or empty are refused; the
+// shipped options file equals the defaults.
 #include "pdvo/infer/detector.h"
 
 #include <gtest/gtest.h>
@@ -156,6 +156,36 @@ TEST(Detector, KeepsTheGroundHorizontalWhereItsRecognitionSaysWall) {
     }
   }
   EXPECT_GE(best, 0.5) << "the ground's best match within 30 degrees";
+}
+
+// The words' prior: a point's planarity's log-odds move by the weight times its two words' log-odds, summed and
+// held within 3 either way; words that say nothing change nothing.
+TEST(Detector, TheWordsPriorMovesEachPointsPlanarityLogOdds) {
+  const StreetFrame s = RenderStreet(952, 5);
+  PlaneModel model = DefaultDetector().recogniser().model();
+  const Eigen::Index words = model.gradient_words.size() + model.colour_words.size();
+  DetectorOptions off;
+  off.word_prior_weight = 0;
+  const Detections without = Detector(model, off).Detect(s.image, s.camera);
+  const auto logit = [](double p) { return std::log(p / (1 - p)); };
+  const auto clamped_logit = [&](double p) { return logit(std::clamp(p, 1e-3, 1 - 1e-3)); };  // as MRF 1 clamps
+  model.word_plane_log_odds = Eigen::VectorXd::Zero(words);
+  const Detections nothing_said = Detector(model, DetectorOptions{}).Detect(s.image, s.camera);
+  ASSERT_EQ(nothing_said.planarity.size(), without.planarity.size());
+  for (size_t i = 0; i < without.planarity.size(); ++i)
+    EXPECT_NEAR(logit(nothing_said.planarity[i]), clamped_logit(without.planarity[i]), 1e-9) << i;
+  for (const double odds : {-0.5, 2.0}) {  // per word; a point's two words sum to -1 (kept) or 4 (held at 3)
+    model.word_plane_log_odds = Eigen::VectorXd::Constant(words, odds);
+    DetectorOptions half;
+    half.word_prior_weight = 0.5;
+    const Detections with = Detector(model, half).Detect(s.image, s.camera);
+    ASSERT_EQ(with.planarity.size(), without.planarity.size());
+    for (size_t i = 0; i < with.planarity.size(); ++i) {
+      EXPECT_NEAR(logit(with.planarity[i]) - clamped_logit(without.planarity[i]), 0.5 * std::clamp(2 * odds, -3.0, 3.0),
+                  1e-8)
+          << i;
+    }
+  }
 }
 
 TEST(Detector, TheSameImageGivesTheSameBytesFromAnyThread) {

@@ -59,6 +59,7 @@ TEST(Model, RoundTripGivesTheSameBytesAndPredictions) {
   EXPECT_EQ(back.card.git_commit, "abc1234");
   EXPECT_EQ(back.options, m.options);
   EXPECT_EQ(back.topics, m.topics);  // doubles round trip exactly
+  EXPECT_EQ(back.word_plane_log_odds, m.word_plane_log_odds);
   std::mt19937 rng(2);
   std::normal_distribution<double> g(0, 1);
   const Eigen::VectorXd x = Eigen::VectorXd::NullaryExpr(m.feature_mean.size(), [&]() { return g(rng); });
@@ -213,9 +214,27 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   ASSERT_NE(other.find(version), std::string::npos);
   other.replace(other.find(version), version.size(), "version: 7");
   other = SealModelText(other);
-  EXPECT_NE(message_of(other).find("model version 7, this build reads versions 3 and " + std::to_string(kModelVersion)),
+  EXPECT_NE(message_of(other).find("model version 7, this build reads versions 3 to " + std::to_string(kModelVersion)),
             std::string::npos)
       << message_of(other);
+  // Version 4 (the learner named, no checksum) is read.
+  std::string four = text;
+  four.replace(four.find(version), version.size(), "version: 4");
+  four.resize(four.rfind("# crc32: "));
+  EXPECT_EQ(PlaneModel::FromYaml(four, "m.yml").ToYaml(), text);
+  // Version 5 (no word log-odds) is read, and gives the detector no prior.
+  std::string five = text;
+  five.replace(five.find(version), version.size(), "version: 5");
+  const size_t odds = five.find("word_plane_log_odds:"), after = five.find("feature_mean:");
+  ASSERT_TRUE(odds != std::string::npos && after > odds);
+  five.erase(odds, after - odds);
+  EXPECT_EQ(PlaneModel::FromYaml(SealModelText(five), "m.yml").word_plane_log_odds.size(), 0);
+  // Word log-odds that do not match the vocabularies are refused.
+  PlaneModel short_odds = RandomModel();
+  short_odds.word_plane_log_odds.conservativeResize(16);
+  EXPECT_NE(message_of(short_odds.ToYaml()).find("m.yml: the word log-odds do not match the vocabularies"),
+            std::string::npos)
+      << message_of(short_odds.ToYaml());
   // Version 3 (RVMs, no learner named) is read; an unknown learner is refused.
   std::string three = text;
   three.replace(three.find(version), version.size(), "version: 3");
@@ -237,6 +256,22 @@ TEST(Model, OtherVersionTruncatedOrForeignFilesFailClearly) {
   PlaneModel none = RandomModel();
   none.classifiers.clear();
   EXPECT_NE(message_of(none.ToYaml()).find("m.yml: no classifiers"), std::string::npos) << message_of(none.ToYaml());
+}
+
+// A word's plane log-odds: its points' odds, smoothed towards the overall share by kWordPriorCounts points, against
+// the overall odds; a word seen on planes and non-planes in the overall proportion says nothing.
+TEST(Model, WordLogOddsAreTheSmoothedOddsAgainstTheOverallOdds) {
+  const Eigen::Vector3d planes(90, 0, 10), non_planes(10, 10, 0);  // 100 of 120 points on planes
+  const Eigen::VectorXd odds = WordPlaneLogOdds(planes, non_planes);
+  const double share = 100.0 / 120, prior = std::log(share / (1 - share));
+  for (int w = 0; w < 3; ++w) {
+    const double p = planes(w) + kWordPriorCounts * share, q = non_planes(w) + kWordPriorCounts * (1 - share);
+    EXPECT_NEAR(odds(w), std::log(p / q) - prior, 1e-12) << w;
+  }
+  EXPECT_GT(odds(0), 0);   // 90 of 100 on planes: a little more than the overall 5 in 6
+  EXPECT_LT(odds(1), -1);  // only on non-planes
+  EXPECT_NEAR(WordPlaneLogOdds(Eigen::Vector2d(50, 50), Eigen::Vector2d(10, 10))(0), 0, 1e-12);
+  EXPECT_THROW(WordPlaneLogOdds(Eigen::Vector2d(5, 5), Eigen::Vector2d(0, 0)), InvalidArgument);
 }
 
 // CRC-32 bit by bit (the reflected polynomial 0xEDB88320), the reference for zlib's table-driven one.

@@ -25,6 +25,7 @@ TEST(ShippedModel, CardRecordsTheDefaultTrainingOptionsVersionAndCommit) {
   options.rvm.gammas = {9.0};
   ApplyOverrides(options, assignments);
   EXPECT_EQ(options, TrainOptions());
+  EXPECT_EQ(model.word_plane_log_odds.size(), model.topics.rows());  // the detector's words' prior (version 6)
 }
 
 }  // namespace

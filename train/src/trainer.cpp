@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 #include <optional>
 #include <random>
 #include <sstream>
 
+#include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/common/logging.h"
 #include "pdvo/common/options.h"
@@ -128,6 +130,28 @@ SettingChoice ChooseSetting(const std::vector<internal::LearnerSetting>& setting
   return best;
 }
 
+// Each salient point's MaskLabel in the annotation (points at the working size of `image`).
+std::vector<uint8_t> PointLabels(const std::vector<cv::Point2f>& points, const AnnotatedImage& image) {
+  const cv::Mat label = Rasterise(image.annotation, image.image.size()).label;
+  std::vector<uint8_t> out;
+  for (const cv::Point2f& p : points) {
+    out.push_back(label.at<uint8_t>(std::clamp(static_cast<int>(std::lround(p.y)), 0, label.rows - 1),
+                                    std::clamp(static_cast<int>(std::lround(p.x)), 0, label.cols - 1)));
+  }
+  return out;
+}
+
+// Adds each annotated point's two words (colour words after the gradient words) to its label's counts.
+void CountWords(const ImageWords& words, const std::vector<uint8_t>& labels, int gradient_words,
+                Eigen::VectorXd* plane_counts, Eigen::VectorXd* non_plane_counts) {
+  for (size_t p = 0; p < words.size(); ++p) {
+    if (labels[p] == kMaskUnknown) continue;
+    Eigen::VectorXd& counts = labels[p] == kMaskPlane ? *plane_counts : *non_plane_counts;
+    counts(words.gradient[p]) += 1;
+    counts(gradient_words + words.colour[p]) += 1;
+  }
+}
+
 }  // namespace
 
 bool RvmOptions::Check() const {
@@ -169,6 +193,23 @@ bool TrainOptions::Check() const {
   return true;
 }
 
+Eigen::VectorXd CountWordPlaneLogOdds(const PlaneModel& model, const std::vector<std::string>& files) {
+  PDVO_THROW_CHECK(!files.empty(), InvalidArgument, "word log-odds: no annotation files");
+  const int gradient_words = model.gradient_words.size();
+  Eigen::VectorXd plane_counts = Eigen::VectorXd::Zero(gradient_words + model.colour_words.size());
+  Eigen::VectorXd non_plane_counts = plane_counts;
+  Progress progress("counting words", files.size());
+  for (const std::string& file : files) {
+    const AnnotatedImage a = ReadAnnotatedImage(file, model.options.working_width);
+    const Features features = ExtractFeatures(a.image, model.options.features);
+    CountWords(QuantiseFeatures(features, model.gradient_words, model.colour_words), PointLabels(features.points, a),
+               gradient_words, &plane_counts, &non_plane_counts);
+    progress.Step();
+  }
+  progress.Finish();
+  return WordPlaneLogOdds(plane_counts, non_plane_counts);
+}
+
 PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions& o, uint64_t seed, int folds,
                       const std::string& data_description) {
   CheckOptionsOrThrow(o, "training options");
@@ -180,12 +221,14 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   // 1. Images -> salient points, descriptors and sampled regions.
   Clock::time_point stage = Clock::now();
   std::vector<Features> features;
+  std::vector<std::vector<uint8_t>> point_labels;  // per image and salient point: its MaskLabel
   std::vector<SampledRegion> regions;
   {
     Progress progress("describing images", files.size());
     for (size_t i = 0; i < files.size(); ++i) {
       const AnnotatedImage a = ReadAnnotatedImage(files[i], o.recogniser.working_width);
       features.push_back(ExtractFeatures(a.image, o.recogniser.features));
+      point_labels.push_back(PointLabels(features.back().points, a));
       const EdgePlanes edges = FindEdgePlanes(a.image, a.camera, o.recogniser.vanishing);
       for (LabelledRegion& r : SampleRegions(a.annotation, a.image.size(), o.regions, rng)) {
         const Eigen::Vector2d structure = EdgeStructure(edges, r.region, o.recogniser.vanishing);
@@ -210,6 +253,11 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   std::vector<ImageWords> words;
   for (const Features& f : features) words.push_back(QuantiseFeatures(f, gradient_words, colour_words));
   features.clear();
+  // Each word's points on annotated planes and non-planes: the detector's prior on a point's planarity.
+  Eigen::VectorXd plane_counts = Eigen::VectorXd::Zero(o.gradient_words + o.colour_words);
+  Eigen::VectorXd non_plane_counts = plane_counts;
+  for (size_t i = 0; i < words.size(); ++i)
+    CountWords(words[i], point_labels[i], o.gradient_words, &plane_counts, &non_plane_counts);
   PDVO_LOG(Info) << "[time] vocabularies of " << o.gradient_words << " gradient and " << o.colour_words
                  << " colour words in " << Since(stage) << " s";
 
@@ -369,6 +417,7 @@ PlaneModel TrainModel(const std::vector<std::string>& files, const TrainOptions&
   model.gradient_words = gradient_words;
   model.colour_words = colour_words;
   model.topics = topics.basis;
+  model.word_plane_log_odds = WordPlaneLogOdds(plane_counts, non_plane_counts);
   model.feature_mean = mean;
   model.feature_scale = scale;
   model.card.data = data_description;

@@ -34,6 +34,9 @@ struct DetectorOptions {
   double overlap = 0.5;              // share of a window's side that the next window of its shape overlaps
   bool fuse_window_normals = false;  // fuse each window's normal with its edges' vanishing direction (slower)
   double normal_scale_deg = 15;      // the Cauchy scale of a point's robust mean normal
+  // A point's planarity's log-odds move by this times its two words' plane log-odds (the model's, learned in
+  // training; their sum at most 3 either way): leaves, cars and sky have words of their own. 0: off.
+  double word_prior_weight = 1;
   // The graph's edges: weight = exp(-(distance / distance_scale)^2 / 2) exp(-(colour difference / colour_scale)^2
   // / 2), colours in [0, 1] per channel.
   double distance_scale = 25;  // px
@@ -72,6 +75,7 @@ struct DetectorOptions {
     visit("overlap", self.overlap);
     visit("fuse_window_normals", self.fuse_window_normals);
     visit("normal_scale_deg", self.normal_scale_deg);
+    visit("word_prior_weight", self.word_prior_weight);
     visit("distance_scale", self.distance_scale);
     visit("colour_scale", self.colour_scale);
     visit("plane_smoothness", self.plane_smoothness);

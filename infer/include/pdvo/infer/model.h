@@ -3,6 +3,8 @@
 // vocabularies, the topic basis, the feature standardisation, a committee of classifiers (plane probability;
 // version 3, one classifier before) and three regressors (normal components), and a training card. Version 4
 // names the learner (`learner`: RVM, or OpenCV ml's SVM, kNN or random trees); version 3 files (RVM) are read.
+// Version 6 adds each word's plane log-odds (the detector's prior on a point's planarity from its words; a model
+// without them, such as one of version 5, gives the detector no prior).
 // Writing is atomic; re-writing a read model gives the same bytes. Relevance vectors are stored in single
 // precision (most of the file's bytes; predictions move by about 1e-7 relative), everything else in double.
 #pragma once
@@ -20,7 +22,7 @@
 namespace pdvo {
 
 inline constexpr const char* kModelFormat = "pdvo-plane-model";
-inline constexpr int kModelVersion = 5;  // 5: ends with a checksum line (see SealModelText)
+inline constexpr int kModelVersion = 6;  // 5: ends with a checksum line (see SealModelText); 6: word log-odds
 
 // A sparse kernel machine as dlib's RVM trainers produce it: f(x) = sum_i w_i exp(-gamma |x - v_i|^2) - bias.
 struct RvmFunction {
@@ -124,13 +126,20 @@ struct ModelCard {
   std::string training_options;
   std::string pdvo_version;
   std::string git_commit;
+  // How the word log-odds were counted, when not by this training (pdvo train --word-prior-of): the annotation
+  // folders and the pdvo version and commit that counted them; empty otherwise.
+  std::string word_prior;
 };
 
 struct PlaneModel {
   RecogniserOptions options;
   Vocabulary gradient_words;
   Vocabulary colour_words;
-  Eigen::MatrixXd topics;        // (gradient words + colour words) x topics, non-negative
+  Eigen::MatrixXd topics;  // (gradient words + colour words) x topics, non-negative
+  // Per word (gradient words, then colour words): log(P(plane | word) / P(non-plane | word)) over the training
+  // images' annotated salient points, less the log-odds of all of them (0: the word says nothing); each word's
+  // counts smoothed towards the overall share by kWordPriorCounts points. Empty in models trained before version 6.
+  Eigen::VectorXd word_plane_log_odds;
   Eigen::VectorXd feature_mean;  // standardisation of the region features
   Eigen::VectorXd feature_scale;
   // The plane probability is the mean of the members' (see Recogniser::Predict). Members are trained on
@@ -152,5 +161,10 @@ struct PlaneModel {
 // bit or an edit is found on reading. SealModelText returns `text` with that line replaced or added: for tools
 // and tests that edit a model on purpose.
 std::string SealModelText(std::string text);
+
+inline constexpr double kWordPriorCounts = 20;
+// PlaneModel::word_plane_log_odds from each word's salient points on annotated planes and non-planes (vectors of
+// gradient words + colour words counts).
+Eigen::VectorXd WordPlaneLogOdds(const Eigen::VectorXd& plane_counts, const Eigen::VectorXd& non_plane_counts);
 
 }  // namespace pdvo

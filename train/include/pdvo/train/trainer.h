@@ -120,6 +120,11 @@ struct TrainOptions {
   bool operator==(const TrainOptions&) const = default;
 };
 
+// Each word's plane log-odds (PlaneModel::word_plane_log_odds), counted over the annotation files' salient points
+// with `model`'s feature options and vocabularies, as TrainModel counts them over its training files: the detector's
+// words' prior for a model trained before version 6, without training it again (pdvo train --word-prior-of).
+Eigen::VectorXd CountWordPlaneLogOdds(const PlaneModel& model, const std::vector<std::string>& annotation_files);
+
 // Trains on the annotation files (LabelMe JSON with images beside them). `folds` >= 2 cross-validates the
 // kernel widths (folds grouped by image); 1 takes the first width of each list. Throws pdvo::Error for no
 // files, a missing image, or a class without examples. The same files, options and seed give the same model.

@@ -1,5 +1,5 @@
-// A small plane model for the model and learner tests: 12 gradient words, 5 colour words, 3 topics and a feature
-// standardisation, all random; no classifiers or regressors yet.
+// A small plane model for the model and learner tests: 12 gradient words, 5 colour words, 3 topics, the words'
+// plane log-odds and a feature standardisation, all random; no classifiers or regressors yet.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -22,6 +22,8 @@ inline PlaneModel RandomModelWithoutLearners(std::mt19937& rng) {
   const int dims = RegionFeatureDims(3);
   m.feature_mean = Eigen::VectorXd::NullaryExpr(dims, [&]() { return u(rng); });
   m.feature_scale = Eigen::VectorXd::NullaryExpr(dims, [&]() { return 0.5 + u(rng); });
+  std::mt19937 own(5);  // the caller's draws stay as they were before the word log-odds
+  m.word_plane_log_odds = Eigen::VectorXd::NullaryExpr(17, [&]() { return 4 * u(own) - 2; });
   return m;
 }
 
