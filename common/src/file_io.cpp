@@ -95,7 +95,12 @@ void RemoveStagingOnInterrupt() {
     if (sigwait(&signals, &signal) != 0) return;
     std::lock_guard<std::mutex> lock(removal_mutex);  // held to the end: a Commit() in progress finishes first
     std::error_code ec;
-    for (const std::string& path : RemoveOnInterrupt()) fs::remove_all(path, ec);
+    // The other threads run on meanwhile: a file one of them opens in a staging folder while it is being removed
+    // keeps the folder from going (not empty), so it is removed again until it has gone. Once it has, nothing can
+    // make it again: the folders inside one are made only under the lock (WriteFileAtomically).
+    for (const std::string& path : RemoveOnInterrupt()) {
+      for (int attempt = 0; attempt < 100 && fs::exists(path, ec); ++attempt) fs::remove_all(path, ec);
+    }
     _exit(128 + signal);
   }).detach();
 }
