@@ -4,6 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pdvo/annotations/mask_polygons.h"
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
 #include "pdvo/common/geometry.h"
@@ -130,6 +131,29 @@ TEST(MaskToPolygons, ScalesToFullResolutionAndDropsSmallRegions) {
   for (const auto& p : polygons[0]) min_x = std::min(min_x, p.x()), max_x = std::max(max_x, p.x());
   EXPECT_DOUBLE_EQ(min_x, 20.5);
   EXPECT_DOUBLE_EQ(max_x, 58.5);
+}
+
+// A plane whose (estimated) normal points away from the camera at its polygon is kept, its normal turned just past
+// edge-on, where the annotation's rules would have dropped it; a normal that faces the camera is kept as it is.
+TEST(AddShapesFromMasks, TurnsANormalThatPointsAwayToFaceTheCamera) {
+  Annotation a;
+  a.image_width = 100, a.image_height = 100;
+  a.camera = Camera::Pinhole(100, 100, 100, 100, 49.5, 49.5);
+  cv::Mat mask(100, 100, CV_8U, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(60, 40, 30, 20), cv::Scalar(255), cv::FILLED);  // right of the centre
+  const Eigen::Vector3d away = Eigen::Vector3d(1, 0, 0.2).normalized(), facing(0, 0, -1);
+  AddShapesFromMasks({{mask, away, 0.7}, {mask.t(), facing, 0.9}}, cv::Mat::zeros(100, 100, CV_8U), {}, &a);
+  ASSERT_EQ(a.shapes.size(), 2u);
+  for (const ValidationIssue& issue : Validate(a)) EXPECT_FALSE(issue.is_error) << issue.message;
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : a.shapes[0].points) centroid += p;
+  const Eigen::Vector3d ray = a.camera->Unproject(centroid / a.shapes[0].points.size()).normalized();
+  const Eigen::Vector3d turned = *a.shapes[0].normal;
+  EXPECT_NEAR(turned.dot(ray), -0.01, 1e-9);  // just past edge-on
+  // The nearest such normal: only its component along the ray changed.
+  const Eigen::Vector3d across = away - away.dot(ray) * ray;
+  EXPECT_LT(AngleDeg(turned - turned.dot(ray) * ray, across), 1e-6);
+  EXPECT_EQ(*a.shapes[1].normal, facing);
 }
 
 }  // namespace
