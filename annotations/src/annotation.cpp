@@ -104,6 +104,13 @@ std::vector<Eigen::Vector2d> Distinct(const std::vector<Eigen::Vector2d>& polygo
 }
 }  // namespace
 
+Eigen::Vector3d PolygonRay(const std::vector<Eigen::Vector2d>& polygon, const Camera& camera) {
+  const std::vector<Eigen::Vector2d> distinct = Distinct(polygon);
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& p : distinct) centroid += p;
+  return camera.Unproject(centroid / static_cast<double>(std::max<size_t>(1, distinct.size())));
+}
+
 Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   json j;
   try {
@@ -323,11 +330,7 @@ std::vector<ValidationIssue> Validate(const Annotation& a) {
     if (a.camera) {
       // The plane is seen, so the camera is on its front side: the normal faces every viewing ray in the
       // polygon. Tested at the centroid of the vertices.
-      Eigen::Vector2d c = Eigen::Vector2d::Zero();
-      for (const auto& p : distinct) c += p;
-      c /= static_cast<double>(distinct.size());
-      const Eigen::Vector3d ray = a.camera->Unproject(c);
-      if (n.dot(ray) >= 0) error(index, "normal points away from the camera");
+      if (n.dot(PolygonRay(distinct, *a.camera)) >= 0) error(index, "normal points away from the camera");
     }
   }
   if (geometry_ok) {

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/annotations/raster.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/logging.h"
 
 namespace pdvo {
@@ -64,23 +65,6 @@ std::vector<std::vector<Eigen::Vector2d>> MaskToPolygons(const cv::Mat& mask_in,
   return polygons;
 }
 
-// A seen plane faces the camera: a normal that points away along the ray through the polygon's vertex centroid (where
-// Validate tests it) is turned to the nearest one that does not, just past edge-on (an estimated normal, e.g. a
-// detector's, at a grazing angle); a normal that faces the camera is returned as it is.
-Eigen::Vector3d FacingAtCentroid(const Eigen::Vector3d& normal, const std::vector<Eigen::Vector2d>& polygon,
-                                 const Camera& camera) {
-  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& p : polygon) centroid += p;
-  centroid /= static_cast<double>(polygon.size());
-  const Eigen::Vector3d ray = camera.Unproject(centroid).normalized();
-  const double away = normal.dot(ray);
-  if (away < 0) return normal;
-  constexpr double kPastEdgeOn = 0.01;  // minus the turned normal's cosine with the ray: about half a degree
-  const Eigen::Vector3d across = normal - away * ray;
-  if (across.norm() < 1e-9) return -ray;
-  return std::sqrt(1 - kPastEdgeOn * kPastEdgeOn) * across.normalized() - kPastEdgeOn * ray;
-}
-
 void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& nonplanar_in,
                         const MaskPolygonOptions& options, Annotation* a) {
   const cv::Size size = nonplanar_in.size();
@@ -95,7 +79,9 @@ void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& non
       shape.points = std::move(polygon);
       shape.normal = plane.normal;
       shape.score = plane.score;
-      if (a->camera) shape.normal = FacingAtCentroid(*shape.normal, shape.points, *a->camera);
+      // An estimated normal (a detector's) made to face the camera elsewhere may point away at this polygon:
+      // turned just past edge-on there, rather than the plane dropped below. A true plane's always faces it.
+      if (a->camera) shape.normal = NearestFacingNormal(*shape.normal, PolygonRay(shape.points, *a->camera), 0.01);
       a->shapes.push_back(std::move(shape));
       covered |= RasteriseShape(a->shapes.back(), *a, size);
     }

@@ -10,6 +10,15 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
 }
 
+Eigen::Vector3d NearestFacingNormal(const Eigen::Vector3d& normal, const Eigen::Vector3d& ray, double past_edge_on) {
+  const Eigen::Vector3d r = ray.normalized();
+  const double away = normal.dot(r);
+  if (away < 0) return normal;
+  const Eigen::Vector3d across = normal - away * r;
+  if (across.norm() <= 1e-9) return -r;
+  return std::sqrt(1 - past_edge_on * past_edge_on) * across.normalized() - past_edge_on * r;
+}
+
 Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;

@@ -248,7 +248,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   // that mostly see facades outvote.
   const Eigen::VectorXd& word_odds = model.word_plane_log_odds;
   if (o.word_prior_weight > 0 && word_odds.size() > 0) {
-    const Eigen::Index colour_offset = word_odds.size() - model.colour_words.size();
+    const int colour_offset = model.gradient_words.size();  // the colour words follow the gradient words
     for (int i = 0; i < n; ++i) {
       const double words_say = std::clamp(word_odds(words.gradient[i]) + word_odds(colour_offset + words.colour[i]),
                                           -kMaxWordLogOdds, kMaxWordLogOdds);
@@ -380,23 +380,28 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     s.mask = std::move(mask);
     const cv::Rect box = cv::boundingRect(s.mask);
     if (box.area() == 0) return std::nullopt;
-    std::vector<Eigen::Vector3d> member_normals;
-    std::vector<double> member_weights;
-    for (const int i : members) {
-      member_normals.push_back(d.normals[i]);
-      member_weights.push_back(d.planarity[i]);
-    }
-    const Eigen::Vector3d mean = RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    auto points_mean = [&] {  // the members' robust mean normal, weighted by their planarity
+      std::vector<Eigen::Vector3d> member_normals;
+      std::vector<double> member_weights;
+      for (const int i : members) {
+        member_normals.push_back(d.normals[i]);
+        member_weights.push_back(d.planarity[i]);
+      }
+      return RobustMeanDirection(member_normals, member_weights, o.normal_scale_deg);
+    };
     if (!o.rerecognise) {
       for (const int i : members) s.score += d.planarity[i] / static_cast<double>(members.size());
-      s.normal = mean;
+      s.normal = points_mean();
       return s;
     }
     const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
     if (!p.valid || p.plane_probability < o.min_plane_probability) return std::nullopt;
     const double horizontal = model.options.vanishing.horizontal_cos;
-    const bool ground = std::abs(mean.dot(words.edges.up)) > horizontal;
-    s.normal = ground && std::abs(p.normal.dot(words.edges.up)) < horizontal ? mean : p.normal;
+    s.normal = p.normal;
+    if (std::abs(p.normal.dot(words.edges.up)) < horizontal) {  // called vertical: unless the points say ground
+      const Eigen::Vector3d mean = points_mean();
+      if (std::abs(mean.dot(words.edges.up)) > horizontal) s.normal = mean;
+    }
     s.score = p.plane_probability;
     return s;
   };

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pdvo/common/errors.h"
+#include "pdvo/common/geometry.h"
 #include "pdvo/common/options.h"
 
 namespace pdvo {
@@ -218,31 +219,17 @@ Eigen::Vector3d RegionRay(const Camera& camera, const Region& region) {
   return camera.Unproject({region.box.x + 0.5 * (region.box.width - 1), region.box.y + 0.5 * (region.box.height - 1)});
 }
 
-namespace {
-
-// `n` if it faces the camera along `ray`, else the nearest unit normal that does (edge-on to the ray): the most
-// probable one if n's error is symmetric about it.
-Eigen::Vector3d NearestFacing(const Eigen::Vector3d& n, const Eigen::Vector3d& ray) {
-  const Eigen::Vector3d r = ray.normalized();
-  const double away = n.dot(r);
-  if (away <= 0) return n;
-  const Eigen::Vector3d edge_on = n - away * r;
-  return edge_on.norm() > 1e-9 ? Eigen::Vector3d(edge_on.normalized()) : Eigen::Vector3d(-r);
-}
-
-}  // namespace
-
 Eigen::Vector3d FuseNormal(const Eigen::Vector3d& model_normal, const EdgePlanes& edges, const Region& region,
                            const VanishingOptions& o) {
   const Eigen::Vector3d ray = RegionRay(edges.camera, region);
-  if (!o.fuse_normals || !edges.up_found) return NearestFacing(model_normal, ray);
+  if (!o.fuse_normals || !edges.up_found) return NearestFacingNormal(model_normal, ray);
   // The fused plane is seen, so it faces the camera at the region's centre: a horizontal plane below the
   // horizon from above, one above it from below; a vertical plane on the side of the ray.
   if (std::abs(model_normal.dot(edges.up)) > o.horizontal_cos) {
     return edges.up.dot(ray) < 0 ? edges.up : Eigen::Vector3d(-edges.up);
   }
   const AzimuthLikelihood l = RegionAzimuthLikelihood(edges, region, o);
-  if (l.empty()) return NearestFacing(model_normal, ray);
+  if (l.empty()) return NearestFacingNormal(model_normal, ray);
   const double prior_phi = l.Phi(model_normal);
   double best_phi = 0, best = -1e300;
   auto consider = [&](const std::vector<double>& phis) {  // the posterior's largest over phis, if larger

@@ -29,6 +29,22 @@ TEST(Geometry, AngleBetweenDirections) {
   }
 }
 
+// A normal facing the camera is kept; one pointing away becomes the nearest facing one, edge-on or just past it,
+// changed only along the ray.
+TEST(Geometry, NearestFacingNormalTurnsOnlyAlongTheRay) {
+  const Eigen::Vector3d ray(0.3, -0.1, 1);
+  const Eigen::Vector3d facing = Eigen::Vector3d(0.2, 0.1, -1).normalized();
+  EXPECT_EQ(NearestFacingNormal(facing, ray, 0.01), facing);
+  const Eigen::Vector3d away = Eigen::Vector3d(1, 0.3, 0.4).normalized(), r = ray.normalized();
+  for (const double past : {0.0, 0.01, 0.1}) {
+    const Eigen::Vector3d n = NearestFacingNormal(away, ray, past);
+    EXPECT_NEAR(n.norm(), 1, 1e-12);
+    EXPECT_NEAR(n.dot(r), -past, 1e-12);
+    EXPECT_LT(AngleDeg(n - n.dot(r) * r, away - away.dot(r) * r), 1e-6);  // the same direction across the ray
+  }
+  EXPECT_LT((NearestFacingNormal(r, ray) + r).norm(), 1e-12);  // along the ray: turned to face it head-on
+}
+
 TEST(Geometry, HatIsTheCrossProduct) {
   std::mt19937 rng(1);
   for (int i = 0; i < 20; ++i) {

@@ -78,6 +78,10 @@ void ValidateOrThrow(const Annotation& annotation, const std::string& where);
 // True if two polygon edges, other than neighbours, cross or touch. O(n^2) in the number of points.
 bool PolygonSelfIntersects(const std::vector<Eigen::Vector2d>& polygon);
 
+// The viewing ray (camera frame, z = 1) through the centroid of a polygon's distinct vertices: where Validate tests
+// that a plane's normal faces the camera.
+Eigen::Vector3d PolygonRay(const std::vector<Eigen::Vector2d>& polygon, const Camera& camera);
+
 // Area of a simple polygon (shoelace), in square pixels.
 double PolygonArea(const std::vector<Eigen::Vector2d>& polygon);
 

@@ -23,6 +23,11 @@ Eigen::Vector3d LogSO3(const Eigen::Quaterniond& q);
 // The angle between two directions (vectors of any non-zero length), in degrees, in [0, 180].
 double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 
+// A seen plane faces the camera (normal . ray < 0). `normal` if it does; else the nearest unit normal that does,
+// `past_edge_on` beyond edge-on (its cosine with the unit ray is -past_edge_on; 0: exactly edge-on), or -ray when
+// `normal` lies along the ray.
+Eigen::Vector3d NearestFacingNormal(const Eigen::Vector3d& normal, const Eigen::Vector3d& ray, double past_edge_on = 0);
+
 // The left Jacobian of SO(3) at phi, used by the SE(3) maps.
 Eigen::Matrix3d LeftJacobianSO3(const Eigen::Vector3d& phi);
 
