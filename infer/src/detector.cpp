@@ -371,8 +371,9 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   };
   // A plane segment of these points and this area, recognised again (its final normal and score), or none if the
   // recognition rejects it (without re-recognition: its points' robust mean normal and mean planarity). Where the
-  // points' mean normal is horizontal and the recognition's is not, the mean is kept: a wide stretch of road and
-  // pavement is recognised less surely than by the windows over its parts (docs/detector.md).
+  // points' mean normal is horizontal and the recognition's is not, the plane is horizontal (the image's vertical
+  // as its normal, the mean without one): a wide stretch of road and pavement is recognised less surely than by the
+  // windows over its parts (docs/detector.md).
   auto plane_of = [&](const std::vector<int>& members, cv::Mat mask) -> std::optional<DetectedSegment> {
     DetectedSegment s;
     s.planar = true;
@@ -400,7 +401,8 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
     s.normal = p.normal;
     if (std::abs(p.normal.dot(words.edges.up)) < horizontal) {  // called vertical: unless the points say ground
       const Eigen::Vector3d mean = points_mean();
-      if (std::abs(mean.dot(words.edges.up)) > horizontal) s.normal = mean;
+      if (std::abs(mean.dot(words.edges.up)) > horizontal)  // then the vertical itself, as FuseNormal would have
+        s.normal = !words.edges.up_found ? mean : mean.dot(words.edges.up) > 0 ? words.edges.up : -words.edges.up;
     }
     s.score = p.plane_probability;
     return s;

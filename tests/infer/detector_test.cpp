@@ -141,21 +141,24 @@ TEST(Detector, FindsTheLargePlanesOfARenderedStreet) {
 
 // A wide stretch of road and pavement beside a facade, which the recogniser, seeing it whole, takes for a wall 88
 // degrees off (validation street 605, frame 2): the windows over its parts call it horizontal, and so does the
-// detection (measured: IoU 0.70, 14 degrees off, the windows' mean).
+// detection, with the image's vertical as its normal (measured: IoU 0.69, 2.3 degrees off; 15.1 with the windows'
+// mean normal).
 TEST(Detector, KeepsTheGroundHorizontalWhereItsRecognitionSaysWall) {
   const StreetFrame s = RenderStreet(605, 2, 60);
   const Detections d = DefaultDetector().Detect(s.image, s.camera);
   const Annotation detected = d.ToAnnotation("frame.png", s.image.cols, s.image.rows, s.camera);
-  double best = 0;
+  double best = 0, angle = 180;
   for (const AnnotationShape& truth : s.truth.shapes) {
     if (!truth.IsPlane() || std::abs(truth.normal->y()) < 0.9) continue;  // the ground (y is down)
     const cv::Mat t = RasteriseShape(truth, s.truth);
     for (const AnnotationShape& shape : detected.shapes) {
-      if (shape.IsPlane() && AngleDeg(*shape.normal, *truth.normal) <= 30)
-        best = std::max(best, Iou(RasteriseShape(shape, detected), t));
+      if (!shape.IsPlane() || AngleDeg(*shape.normal, *truth.normal) > 30) continue;
+      const double iou = Iou(RasteriseShape(shape, detected), t);
+      if (iou > best) best = iou, angle = AngleDeg(*shape.normal, *truth.normal);
     }
   }
   EXPECT_GE(best, 0.5) << "the ground's best match within 30 degrees";
+  EXPECT_LE(angle, 3) << "its normal: the image's vertical";
 }
 
 // The words' prior: a point's planarity's log-odds move by the weight times its two words' log-odds, summed and
