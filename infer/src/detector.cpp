@@ -371,9 +371,9 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   };
   // A plane segment of these points and this area, recognised again (its final normal and score), or none if the
   // recognition rejects it (without re-recognition: its points' robust mean normal and mean planarity). Where the
-  // points' mean normal is horizontal and the recognition's is not, the plane is horizontal (the image's vertical
-  // as its normal, the mean without one): a wide stretch of road and pavement is recognised less surely than by the
-  // windows over its parts (docs/detector.md).
+  // points' mean normal is horizontal and the recognition's is not, the plane is horizontal (FuseNormal of that
+  // mean: the image's vertical, facing the camera): a wide stretch of road and pavement is recognised less surely than
+  // by the windows over its parts (docs/detector.md).
   auto plane_of = [&](const std::vector<int>& members, cv::Mat mask) -> std::optional<DetectedSegment> {
     DetectedSegment s;
     s.planar = true;
@@ -395,14 +395,16 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
       s.normal = points_mean();
       return s;
     }
-    const RegionPrediction p = recogniser_.Recognise(words, Region{box, s.mask(box).clone()});
+    const Region region{box, s.mask(box).clone()};
+    const RegionPrediction p = recogniser_.Recognise(words, region);
     if (!p.valid || p.plane_probability < o.min_plane_probability) return std::nullopt;
-    const double horizontal = model.options.vanishing.horizontal_cos;
+    const VanishingOptions& vanishing = model.options.vanishing;
     s.normal = p.normal;
-    if (std::abs(p.normal.dot(words.edges.up)) < horizontal) {  // called vertical: unless the points say ground
+    // Called vertical, but the points say ground: fused as a recognised ground is (the image's vertical).
+    if (std::abs(p.normal.dot(words.edges.up)) < vanishing.horizontal_cos) {
       const Eigen::Vector3d mean = points_mean();
-      if (std::abs(mean.dot(words.edges.up)) > horizontal)  // then the vertical itself, as FuseNormal would have
-        s.normal = !words.edges.up_found ? mean : mean.dot(words.edges.up) > 0 ? words.edges.up : -words.edges.up;
+      if (std::abs(mean.dot(words.edges.up)) > vanishing.horizontal_cos)
+        s.normal = FuseNormal(mean, words.edges, region, vanishing);
     }
     s.score = p.plane_probability;
     return s;
