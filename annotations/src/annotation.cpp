@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include "pdvo/annotations/raster.h"
 #include "pdvo/common/errors.h"
@@ -68,8 +69,14 @@ AnnotationShape ParseShape(const json& j, const std::string& where) {
     shape.normal = normal;
   }
   if (j.contains("score") && !j["score"].is_null()) shape.score = Number(j["score"], where, "score");
+  if (j.contains("group_id") && !j["group_id"].is_null()) {
+    PDVO_THROW_CHECK(j["group_id"].is_number_integer(), FormatError,
+                     where << ": 'group_id' must be an integer or null");
+    shape.group_id = j["group_id"].get<int>();
+  }
   for (const auto& [key, value] : j.items()) {
-    if (key != "label" && key != "points" && key != "normal" && key != "score" && key != "shape_type") {
+    if (key != "label" && key != "points" && key != "normal" && key != "score" && key != "shape_type" &&
+        key != "group_id") {
       shape.extra[key] = value;
     }
   }
@@ -170,6 +177,23 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   return a;
 }
 
+std::vector<int> PlaneOfShape(const Annotation& a) {
+  std::vector<int> plane(a.shapes.size(), -1);
+  std::map<int, int> of_group;
+  int planes = 0;
+  for (size_t i = 0; i < a.shapes.size(); ++i) {
+    if (!a.shapes[i].IsPlane()) continue;
+    if (!a.shapes[i].group_id) {
+      plane[i] = planes++;
+      continue;
+    }
+    const auto [at, added] = of_group.emplace(*a.shapes[i].group_id, planes);
+    plane[i] = at->second;
+    planes += added;
+  }
+  return plane;
+}
+
 Annotation ReadAnnotation(const std::string& path) { return ParseAnnotation(ReadFile(path), path); }
 
 std::string AnnotationToJson(const Annotation& a) {
@@ -187,7 +211,7 @@ std::string AnnotationToJson(const Annotation& a) {
     json js;
     js["label"] = s.label;
     js["shape_type"] = "polygon";
-    js["group_id"] = nullptr;
+    js["group_id"] = s.group_id ? json(*s.group_id) : json(nullptr);
     js["flags"] = json::object();
     for (const auto& [key, value] : s.extra.items()) js[key] = value;
     json points = json::array();

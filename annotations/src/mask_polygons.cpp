@@ -71,6 +71,8 @@ void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& non
   const double scale = static_cast<double>(a->image_width) / size.width;
   const size_t first = a->shapes.size();
   cv::Mat covered(size, CV_8U, cv::Scalar(0));
+  int group = 0;  // each plane's pieces share a group_id, after any the annotation holds
+  for (const AnnotationShape& s : a->shapes) group = std::max(group, s.group_id.value_or(-1) + 1);
   for (const PlaneMask& plane : planes) {
     for (auto& polygon : MaskToPolygons(plane.mask, options.min_plane_pixels, options.min_hole_pixels, scale,
                                         options.epsilon_full_px)) {
@@ -79,12 +81,14 @@ void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& non
       shape.points = std::move(polygon);
       shape.normal = plane.normal;
       shape.score = plane.score;
+      shape.group_id = group;
       // An estimated normal (a detector's) made to face the camera elsewhere may point away at this polygon:
       // turned just past edge-on there, rather than the plane dropped below. A true plane's always faces it.
       if (a->camera) shape.normal = NearestFacingNormal(*shape.normal, PolygonRay(shape.points, *a->camera), 0.01);
       a->shapes.push_back(std::move(shape));
       covered |= RasteriseShape(a->shapes.back(), *a, size);
     }
+    ++group;
   }
   const int margin = 2 + static_cast<int>(std::ceil(2 * options.epsilon_full_px / scale));
   cv::dilate(covered, covered, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));

@@ -35,7 +35,7 @@ TEST(Annotation, WriteReadRoundTripKeepsEverything) {
   test::TempDir dir;
   Annotation a = Square(10, 10, 20);
   a.shapes[0].score = 0.75;
-  a.shapes[0].extra["group_id"] = 3;
+  a.shapes[0].group_id = 3;
   a.shapes[0].extra["description"] = "left facade";
   a.extra["flags"] = {{"reviewed", true}};
   a.shapes.push_back(Square(50, 10, 20, kNonPlaneLabel).shapes[0]);
@@ -50,7 +50,8 @@ TEST(Annotation, WriteReadRoundTripKeepsEverything) {
   EXPECT_EQ(*b.shapes[0].normal, Eigen::Vector3d(0, 0, -1));
   EXPECT_DOUBLE_EQ(*b.shapes[0].score, 0.75);
   EXPECT_EQ(b.shapes[0].extra["description"], "left facade");
-  EXPECT_EQ(b.shapes[0].extra["group_id"], 3);
+  EXPECT_EQ(b.shapes[0].group_id, 3);
+  EXPECT_FALSE(b.shapes[1].group_id.has_value());
   EXPECT_TRUE(b.shapes[1].IsNonPlane());
   EXPECT_FALSE(b.shapes[1].normal.has_value());
   EXPECT_EQ(b.extra["flags"]["reviewed"], true);
@@ -101,6 +102,9 @@ TEST(Annotation, WrongTypesAndMissingKeysNameShapeAndKey) {
   EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10,
                          "shapes": [{"label": "plane", "points": [], "normal": [1, 2]}]})"),
             "f.json: shape 0: 'normal' must be [nx, ny, nz]");
+  EXPECT_EQ(error_of(R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10,
+                         "shapes": [{"label": "plane", "points": [], "group_id": "left"}]})"),
+            "f.json: shape 0: 'group_id' must be an integer or null");
   EXPECT_EQ(error_of("[1, 2]"), "f.json: expected a JSON object");
   // Hostile input: refused before it is copied, allocated or converted.
   std::string deep = R"({"imagePath": "x", "imageWidth": 10, "imageHeight": 10, "shapes": [], "mine": )";
@@ -207,6 +211,16 @@ TEST(Annotation, PolygonHelpers) {
   // A concave "U" does not cross itself; one whose arm touches the other side does.
   EXPECT_FALSE(PolygonSelfIntersects({{0, 0}, {6, 0}, {6, 6}, {4, 6}, {4, 2}, {2, 2}, {2, 6}, {0, 6}}));
   EXPECT_TRUE(PolygonSelfIntersects({{0, 0}, {6, 0}, {6, 6}, {4, 6}, {4, 2}, {0, 2}, {2, 6}, {0, 6}}));
+}
+
+// Plane shapes of one group_id are one plane; a plane shape without one is a plane of its own; others none.
+TEST(Annotation, PlaneOfShapeGroupsPiecesOfOnePlane) {
+  Annotation a = Square(10, 10, 20);
+  for (int k = 0; k < 4; ++k) a.shapes.push_back(a.shapes[0]);
+  a.shapes[1].group_id = a.shapes[3].group_id = 5;
+  a.shapes[2].label = kNonPlaneLabel;
+  a.shapes[4].group_id = 2;
+  EXPECT_EQ(PlaneOfShape(a), (std::vector<int>{0, 1, -1, 1, 2}));
 }
 
 TEST(Annotation, ResolvesImagePathRelativeToTheJsonFolder) {

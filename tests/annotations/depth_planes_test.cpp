@@ -154,6 +154,29 @@ TEST(AddShapesFromMasks, TurnsANormalThatPointsAwayToFaceTheCamera) {
   const Eigen::Vector3d across = away - away.dot(ray) * ray;
   EXPECT_LT(AngleDeg(turned - turned.dot(ray) * ray, across), 1e-6);
   EXPECT_EQ(*a.shapes[1].normal, facing);
+  EXPECT_NE(a.shapes[0].group_id, a.shapes[1].group_id);  // two planes
+}
+
+// A plane in two pieces (a pole in front of it) gives two polygons of one group_id, after the groups already there.
+TEST(AddShapesFromMasks, PiecesOfOnePlaneShareAGroup) {
+  Annotation a;
+  a.image_width = 100, a.image_height = 100;
+  AnnotationShape earlier;
+  earlier.label = kPlaneLabel;
+  earlier.points = {{0, 0}, {5, 0}, {5, 5}};
+  earlier.group_id = 4;
+  a.shapes.push_back(earlier);
+  cv::Mat wall(100, 100, CV_8U, cv::Scalar(0)), ground(100, 100, CV_8U, cv::Scalar(0));
+  cv::rectangle(wall, cv::Rect(10, 10, 30, 40), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(wall, cv::Rect(50, 10, 30, 40), cv::Scalar(255), cv::FILLED);
+  cv::rectangle(ground, cv::Rect(10, 70, 80, 20), cv::Scalar(255), cv::FILLED);
+  const Eigen::Vector3d facing(0, 0, -1);
+  AddShapesFromMasks({{wall, facing, {}}, {ground, facing, {}}}, cv::Mat::zeros(100, 100, CV_8U), {}, &a);
+  ASSERT_EQ(a.shapes.size(), 4u);
+  EXPECT_EQ(a.shapes[1].group_id, 5);
+  EXPECT_EQ(a.shapes[2].group_id, 5);
+  EXPECT_EQ(a.shapes[3].group_id, 6);
+  EXPECT_EQ(PlaneOfShape(a), (std::vector<int>{0, 1, 1, 2}));
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // Detection scores on hand-made annotations with known answers: a perfect detection; one plane over the whole
 // image with a turned normal (half its area false, matched within 30 degrees but not 10); a plane detected as two
 // halves (Rand index about one half, one bit of variation of information, covering one half); why planes are not
-// matched, and what a merged plane runs onto.
+// matched, what a merged plane runs onto, and the pieces of one plane (one group_id) scored as one plane.
 #include "pdvo/eval/detection.h"
 
 #include <gtest/gtest.h>
@@ -75,6 +75,29 @@ TEST(DetectionScore, APlaneInTwoHalves) {
   Annotation other = Reference();
   other.image_width = 50;
   EXPECT_THROW(ScoreDetection(Reference(), other), FormatError);
+}
+
+// A plane seen on both sides of a pole: its two pieces (columns 0-19 and 30-49) share a group_id and are one
+// reference plane, which one detected plane over columns 0-49 matches (IoU 0.8); as two planes, each piece would
+// hold under half of that detection (IoU 0.4) and neither would be matched. Detected pieces are grouped likewise.
+TEST(DetectionScore, PiecesOfOnePlaneAreOnePlane) {
+  AnnotationShape left = Rect(kPlaneLabel, -0.5, -0.5, 19.5, 79.5, kFacing);
+  AnnotationShape right = Rect(kPlaneLabel, 29.5, -0.5, 49.5, 79.5, kFacing);
+  const AnnotationShape pole = Rect(kNonPlaneLabel, 19.5, -0.5, 29.5, 79.5);
+  const Annotation whole = Image({Rect(kPlaneLabel, -0.5, -0.5, 49.5, 79.5, kFacing)});
+  const DetectionScore apart = ScoreDetection(Image({left, right, pole}), whole);
+  EXPECT_EQ(apart.reference_planes, 2);
+  EXPECT_EQ(apart.matched_30, 0);
+  left.group_id = right.group_id = 7;
+  const Annotation grouped = Image({left, right, pole});
+  const DetectionScore together = ScoreDetection(grouped, whole);
+  EXPECT_EQ(together.reference_planes, 1);
+  EXPECT_EQ(together.matched_10, 1);
+  EXPECT_EQ(together.spurious_planes, 0);
+  const DetectionScore both_grouped = ScoreDetection(grouped, grouped);
+  EXPECT_EQ(both_grouped.matched_10, 1);
+  EXPECT_EQ(both_grouped.spurious_planes, 0);
+  EXPECT_DOUBLE_EQ(both_grouped.covering, 1);
 }
 
 // Why a reference plane (the left half, 50 x 80) is not matched: a detection holding all of it and the non-plane

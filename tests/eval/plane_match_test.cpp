@@ -52,6 +52,16 @@ TEST(PlaneMatch, OneToOneAndUnmatchedCountAsZero) {
   Annotation other = est;
   other.image_width = 300;
   EXPECT_THROW(ComparePlanes(ref, other), FormatError);
+  // The two references as pieces of one plane (one group_id): one plane, which the estimate matches whole.
+  Annotation grouped = ref;
+  grouped.shapes[0].group_id = grouped.shapes[1].group_id = 0;
+  grouped.shapes[1].points[0].x() -= 1;  // the second piece a column wider: the largest, which names the plane
+  grouped.shapes[1].points[3].x() -= 1;
+  const PlaneComparison g = ComparePlanes(grouped, est);
+  EXPECT_EQ(g.reference_planes, 1);
+  ASSERT_EQ(g.matches.size(), 1u);
+  EXPECT_EQ(g.matches[0].reference_shape, 1);
+  EXPECT_NEAR(g.matches[0].iou, 1.0, 1e-12);
 }
 
 TEST(PlanePurity, ShareOfPointsOnTheirPlanesMainLabel) {

@@ -298,7 +298,8 @@ namespace pdvo::sim {
 namespace {
 
 // The two parts check each other: annotation from depth, run on a synthetic sequence with the shipped options
-// for its sensor, finds the planes of the exact annotations.
+// for its sensor, finds the planes of the exact annotations. Piece by piece (group_id cleared): the stored depth
+// ends at 32.8 m, so a facade's far pieces lie beyond it, and the whole plane could not be matched.
 TEST(Synth, AnnotateDepthRecoversTheStreetsPlanes) {
   const Scene s(21, 150);
   const Renderer renderer(s.street, s.camera, s.options.render, 21);
@@ -312,8 +313,12 @@ TEST(Synth, AnnotateDepthRecoversTheStreetsPlanes) {
     renderer.RenderGeometry(s.walk[i].world_from_cam, &f);
     cv::Mat depth = f.depth.clone();
     depth.setTo(0, depth > 65535 / kSynthDepthScale);  // as stored
-    const PlaneComparison c = ComparePlanes(AnnotateFrame(s.street, f, s.walk[i].world_from_cam, s.camera, "x.png"),
-                                            finder.Annotate(depth, "x.png"));
+    Annotation truth = AnnotateFrame(s.street, f, s.walk[i].world_from_cam, s.camera, "x.png");
+    Annotation found = finder.Annotate(depth, "x.png");
+    for (Annotation* a : {&truth, &found}) {
+      for (AnnotationShape& shape : a->shapes) shape.group_id.reset();
+    }
+    const PlaneComparison c = ComparePlanes(truth, found);
     for (const PlaneMatch& m : c.matches) {
       ious.push_back(m.iou);
       worst_angle = std::max(worst_angle, m.normal_angle_deg);

@@ -26,6 +26,9 @@ struct AnnotationShape {
   std::vector<Eigen::Vector2d> points;    // pixels of the full-resolution image, (0,0) = top-left pixel centre
   std::optional<Eigen::Vector3d> normal;  // planes: unit normal in the camera frame, towards the camera
   std::optional<double> score;            // detector confidence in [0, 1]
+  // LabelMe's group_id: the pieces of one plane (seen on both sides of a tree, say) share it; none: the shape
+  // is a plane of its own.
+  std::optional<int> group_id;
   nlohmann::json extra = nlohmann::json::object();  // other keys, kept as read
 
   bool IsPlane() const { return label == kPlaneLabel; }
@@ -42,6 +45,10 @@ struct Annotation {
   std::vector<AnnotationShape> shapes;
   nlohmann::json extra = nlohmann::json::object();  // other top-level keys (flags, ...), kept as read
 };
+
+// Per shape, the plane it is a piece of: plane shapes of one group_id are one plane, every other plane shape is
+// one of its own; planes numbered from 0 in the order of their first shape; -1 for other labels.
+std::vector<int> PlaneOfShape(const Annotation& annotation);
 
 // Parses JSON text; `where` names the source in errors. Throws FormatError for malformed JSON, a missing
 // required key or a value of the wrong type, naming the file, the shape and the key.

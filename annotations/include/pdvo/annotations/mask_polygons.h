@@ -34,7 +34,8 @@ struct MaskPolygonOptions {
 // Appends `plane` shapes for the planes and `non-plane` shapes for `nonplanar` (CV_8U) to `annotation`, whose
 // image size must be set. Non-planes keep a margin from the planes' polygons, so that no region of one label
 // overlaps the other. With the annotation's camera, a plane's normal that points away from the camera at its
-// polygon (PolygonRay) is turned to the nearest one that faces it, rather than the plane dropped. A shape that
+// polygon (PolygonRay) is turned to the nearest one that faces it, rather than the plane dropped. A plane's
+// polygons share a group_id (LabelMe's: the pieces of one plane), one per plane after those already there. A shape that
 // would still break the format's rules is dropped.
 void AddShapesFromMasks(const std::vector<PlaneMask>& planes, const cv::Mat& nonplanar,
                         const MaskPolygonOptions& options, Annotation* annotation);

@@ -1,7 +1,9 @@
 // Scoring plane detections against reference annotations of the same image (pdvo evaluate-detection).
 //
 // Both are rasterised at the reference image's size (at most `max_width` wide; where shapes overlap, the later
-// wins). Only pixels the reference annotates (plane or non-plane) are scored:
+// wins). A plane is all the plane shapes of one group_id (LabelMe's grouping: the pieces of one plane, on both
+// sides of a tree, say), or one plane shape without it; its normal is its largest piece's. Only pixels the
+// reference annotates (plane or non-plane) are scored:
 // - pixel precision, recall and F1 of the plane label and of the non-plane label (a pixel the detection leaves
 //   unlabelled counts against both recalls);
 // - false plane area: the share of the detected plane area (on annotated pixels) that lies on reference

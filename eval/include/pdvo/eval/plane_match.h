@@ -2,7 +2,8 @@
 //
 // Planes are matched one to one, greedily by intersection over union of their masks (highest first), above
 // `min_iou`. For each match: IoU and the angle between the normals. Masks are compared at the reference
-// image's size (or scaled to `max_width`).
+// image's size (or scaled to `max_width`). A plane is its pieces (PlaneOfShape: the plane shapes of one
+// group_id), named by and taking the normal of its largest piece.
 #pragma once
 
 #include <map>
@@ -17,7 +18,7 @@
 namespace pdvo {
 
 struct PlaneMatch {
-  int reference_shape = -1, estimated_shape = -1;
+  int reference_shape = -1, estimated_shape = -1;  // each plane's largest piece
   double iou = 0;
   double normal_angle_deg = -1;  // -1 if either has no normal
 };
