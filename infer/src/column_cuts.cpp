@@ -95,6 +95,26 @@ AzimuthTable ColumnAzimuths(const EdgePlanes& edges, const cv::Mat& mask, const 
   return table;
 }
 
+// A run between two runs whose mean colours are within `join_colour` of each other, and no wider than either, is a
+// pulse of another colour in one facade (its windows, a door): the three become one, until none is left.
+void JoinPulses(const ColourTable& colours, const std::vector<int>& column, double join_colour,
+                std::vector<int>* start) {
+  if (join_colour <= 0) return;
+  std::vector<int>& s = *start;
+  auto mean = [&](size_t k) -> Eigen::Vector3d {
+    return (colours.sum[s[k + 1]] - colours.sum[s[k]]) / (s[k + 1] - s[k]);
+  };
+  auto width = [&](size_t k) { return column[s[k + 1] - 1] - column[s[k]] + 1; };
+  for (size_t k = 0; k + 3 < s.size();) {
+    if ((mean(k) - mean(k + 2)).norm() <= join_colour && width(k + 1) <= std::min(width(k), width(k + 2))) {
+      s.erase(s.begin() + static_cast<long>(k) + 1, s.begin() + static_cast<long>(k) + 3);
+      k = k >= 2 ? k - 2 : 0;  // the joined run may now be a pulse, or frame one
+    } else {
+      ++k;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<int> FacadeColumnCuts(const cv::Mat& lab, const EdgePlanes& edges, const cv::Mat& mask,
@@ -127,9 +147,12 @@ std::vector<int> FacadeColumnCuts(const cv::Mat& lab, const EdgePlanes& edges, c
       if (c < best[j]) best[j] = c, from[j] = i;
     }
   }
+  std::vector<int> start{m};  // each run's first column (as an index into `column`), and m after the last
+  for (int j = m; j > 0; j = from[j]) start.push_back(from[j]);
+  std::reverse(start.begin(), start.end());
+  JoinPulses(colours, column, cut.join_colour, &start);
   std::vector<int> cuts;
-  for (int j = m; from[j] > 0; j = from[j]) cuts.push_back(column[from[j]]);
-  std::reverse(cuts.begin(), cuts.end());
+  for (size_t k = 1; k + 1 < start.size(); ++k) cuts.push_back(column[start[k]]);
   return cuts;
 }
 

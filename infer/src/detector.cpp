@@ -178,7 +178,8 @@ bool DetectorOptions::Check() const {
   PDVO_CHECK_OPTION(distance_scale > 0 && colour_scale > 0 && plane_smoothness >= 0);
   PDVO_CHECK_OPTION(orientation_bandwidth_deg > 0 && orientation_merge_deg > 0 && max_orientations >= 1);
   PDVO_CHECK_OPTION(orientation_scale_deg > 0 && orientation_smoothness >= 0);
-  PDVO_CHECK_OPTION(column_split_penalty >= 0 && azimuth_split_penalty >= 0 && column_split_width >= 1);
+  PDVO_CHECK_OPTION(column_split_penalty >= 0 && azimuth_split_penalty >= 0 && column_split_width >= 1 &&
+                    column_join_colour >= 0);
   PDVO_CHECK_OPTION(min_segment_points >= 1 && min_plane_probability >= 0 && min_plane_probability <= 1);
   PDVO_CHECK_OPTION(cell_radius > 0);
   PDVO_CHECK_OPTION(point_quality > 0 && point_quality < 1 && point_min_distance >= 1);
@@ -411,7 +412,7 @@ Detections Detector::Detect(const cv::Mat& image, const std::optional<Camera>& c
   };
   cv::Mat lab;
   const ColumnCutOptions column_cuts{o.column_split_penalty, o.azimuth_split_penalty, o.column_split_width,
-                                     kMinColumnPixels};
+                                     kMinColumnPixels, o.column_join_colour};
   if (o.column_split_penalty > 0 || o.azimuth_split_penalty > 0) {
     work.convertTo(lab, CV_32F, 1.0 / 255);
     cv::cvtColor(lab, lab, cv::COLOR_BGR2Lab);

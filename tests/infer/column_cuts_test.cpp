@@ -1,6 +1,6 @@
 // Cutting a facade's columns (FacadeColumnCuts): by colour, where a facade changes colour under a window pattern; by
 // its edges, where they turn to another vanishing direction (a building's corner) and not where they do not; both
-// against brute force over every set of cuts.
+// against brute force over every set of cuts; a facade's windows joined to it.
 #include "pdvo/infer/column_cuts.h"
 
 #include <gtest/gtest.h>
@@ -43,6 +43,32 @@ TEST(FacadeColumnCuts, FindWhereAFacadeChangesColour) {
   left.colRange(0, 30).setTo(255);
   EXPECT_TRUE(FacadeColumnCuts(facade(37), none, left, Colour(3000, 12, 8), v).empty());
   EXPECT_THROW(FacadeColumnCuts(facade(37), none, cv::Mat(60, 99, CV_8U), Colour(3000, 12, 8), v), InvalidArgument);
+}
+
+// A facade of one colour with a shop window filling most of columns 40-59, then another facade from column 80:
+// cut at 40, 60 and 80 by colour alone; with join_colour the window joins the wall on both sides of it, and the
+// change to the other facade stays. A wide run of another colour between two narrow ones of one colour is no pulse.
+TEST(FacadeColumnCuts, JoinAFacadesWindowsToIt) {
+  const auto facade = [](int from, int to, int other) {
+    cv::Mat lab(60, 120, CV_32FC3);
+    for (int y = 0; y < lab.rows; ++y) {
+      for (int x = 0; x < lab.cols; ++x) {
+        const bool window = x >= from && x < to && y >= 10;  // 5 of 6 of the column
+        lab.at<cv::Vec3f>(y, x) = window      ? cv::Vec3f(40, 0, -10)
+                                  : x < other ? cv::Vec3f(50, 45, 25)
+                                              : cv::Vec3f(60, 35, -8);
+      }
+    }
+    return lab;
+  };
+  const cv::Mat mask(60, 120, CV_8U, cv::Scalar(255));
+  const EdgePlanes none;
+  const VanishingOptions v;
+  ColumnCutOptions join = Colour(3000, 12, 8);
+  EXPECT_EQ(FacadeColumnCuts(facade(40, 60, 80), none, mask, join, v), (std::vector<int>{40, 60, 80}));
+  join.join_colour = 6;
+  EXPECT_EQ(FacadeColumnCuts(facade(40, 60, 80), none, mask, join, v), std::vector<int>{80});
+  EXPECT_EQ(FacadeColumnCuts(facade(20, 100, 120), none, mask, join, v), (std::vector<int>{20, 100}));
 }
 
 // A facade of one colour whose horizontal edges run along one direction left of column `turn` and along another,

@@ -16,6 +16,7 @@ struct ColumnCutOptions {
   double azimuth_penalty = 0;  // and in robust losses of edges of mean strength; 0: the edges say nothing
   int min_width = 12;          // px: the narrowest run, unless it is the only one
   int min_pixels = 8;          // columns with fewer of the mask's pixels are left out
+  double join_colour = 0;      // CIELAB units: pulses joined (below); 0: never
 };
 
 // The runs of the mask's columns (those with at least min_pixels of its pixels) that minimise the sum over runs of
@@ -29,6 +30,9 @@ struct ColumnCutOptions {
 //   edges; a run's is the least over phi (5-degree steps) of its edges' summed losses, small only if one direction
 //   fits all of them. Nothing without a vertical (EdgePlanes::up_found) or with fewer than options.min_edges such
 //   edges in the mask.
+// Then, with join_colour above 0, a run no wider than the runs on both sides, whose mean colours (the mean of their
+// columns') are within join_colour of each other, joins them: a facade's windows or door, which fill most of
+// their columns, are not a facade of their own. Repeated until there is no such run.
 // `mask`: CV_8U of `lab`'s and the edges' size. Returns the x of the first column of every run after the first,
 // increasing.
 std::vector<int> FacadeColumnCuts(const cv::Mat& lab, const EdgePlanes& edges, const cv::Mat& mask,

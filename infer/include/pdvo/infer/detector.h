@@ -53,6 +53,8 @@ struct DetectorOptions {
   double column_split_penalty = 3000;  // colour: squared CIELAB units summed over columns
   double azimuth_split_penalty = 80;   // turn: robust losses of edges of mean strength
   int column_split_width = 12;         // px: the narrowest part
+  double column_join_colour = 6;       // CIELAB units: a part between two of this colour, no wider than either, joins
+                                       // them (a facade's windows or door; column_cuts.h); 0: never
   double min_plane_probability = 0.5;  // a plane segment recognised again below this is dropped
   double cell_radius = 16;             // px: a segment's area is its points' Voronoi cells within this distance
   // The image is described with salient points of its own, in place of the model's (FeatureOptions' quality and
@@ -88,6 +90,7 @@ struct DetectorOptions {
     visit("column_split_penalty", self.column_split_penalty);
     visit("azimuth_split_penalty", self.azimuth_split_penalty);
     visit("column_split_width", self.column_split_width);
+    visit("column_join_colour", self.column_join_colour);
     visit("min_plane_probability", self.min_plane_probability);
     visit("cell_radius", self.cell_radius);
     visit("point_quality", self.point_quality);
