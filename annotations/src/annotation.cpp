@@ -177,21 +177,25 @@ Annotation ParseAnnotation(const std::string& text, const std::string& where) {
   return a;
 }
 
-std::vector<int> PlaneOfShape(const Annotation& a) {
-  std::vector<int> plane(a.shapes.size(), -1);
+AnnotationPlanes PlanesOf(const Annotation& a) {
+  AnnotationPlanes planes;
+  planes.of_shape.assign(a.shapes.size(), -1);
   std::map<int, int> of_group;
-  int planes = 0;
+  std::vector<double> largest_area;
   for (size_t i = 0; i < a.shapes.size(); ++i) {
     if (!a.shapes[i].IsPlane()) continue;
-    if (!a.shapes[i].group_id) {
-      plane[i] = planes++;
-      continue;
+    const int next = static_cast<int>(planes.largest.size());
+    const int p = a.shapes[i].group_id ? of_group.emplace(*a.shapes[i].group_id, next).first->second : next;
+    planes.of_shape[i] = p;
+    const double area = PolygonArea(a.shapes[i].points);
+    if (p == next) {
+      planes.largest.push_back(static_cast<int>(i));
+      largest_area.push_back(area);
+    } else if (area > largest_area[p]) {
+      planes.largest[p] = static_cast<int>(i), largest_area[p] = area;
     }
-    const auto [at, added] = of_group.emplace(*a.shapes[i].group_id, planes);
-    plane[i] = at->second;
-    planes += added;
   }
-  return plane;
+  return planes;
 }
 
 Annotation ReadAnnotation(const std::string& path) { return ParseAnnotation(ReadFile(path), path); }

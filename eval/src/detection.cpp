@@ -17,18 +17,6 @@ double F1(double p, double r) { return p + r > 0 ? 2 * p * r / (p + r) : 0.0; }
 using detail::Median;
 // n choose 2.
 double Pairs(double n) { return 0.5 * n * (n - 1); }
-// Per plane with pixels (PlaneOfShape's numbers), the normal of its piece with the most pixels.
-std::map<int, std::optional<Eigen::Vector3d>> PlaneNormals(const Annotation& a, const std::vector<int>& plane_of,
-                                                           const std::map<int, long>& shape_area) {
-  std::map<int, std::pair<long, std::optional<Eigen::Vector3d>>> largest;
-  for (const auto& [shape, area] : shape_area) {
-    auto& [most, normal] = largest[plane_of[shape]];
-    if (area > most) most = area, normal = a.shapes[shape].normal;
-  }
-  std::map<int, std::optional<Eigen::Vector3d>> normals;
-  for (const auto& [plane, entry] : largest) normals[plane] = entry.second;
-  return normals;
-}
 nlohmann::json ToJson(const Unmatched& u) {
   return {{"turned", u.turned},
           {"merged", u.merged()},
@@ -55,11 +43,14 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
   const cv::Size size = detail::ComparisonSize(reference, detection, options.max_width, "detection score");
   const AnnotationMasks ref = Rasterise(reference, size), det = Rasterise(detection, size);
   // Planes, not shapes: the pieces of one plane (one group_id) are one plane.
-  const std::vector<int> ref_plane_of = PlaneOfShape(reference), det_plane_of = PlaneOfShape(detection);
+  const AnnotationPlanes ref_planes = PlanesOf(reference), det_planes = PlanesOf(detection);
+  const auto normal_of = [](const Annotation& a, const AnnotationPlanes& planes, int plane) -> const auto& {
+    return a.shapes[planes.largest[plane]].normal;  // the plane's: its largest piece's
+  };
   DetectionScore s;
   // Per reference plane and per detected plane: pixel counts and their overlaps.
-  std::map<int, long> ref_area, det_area, ref_shape_area, det_shape_area;
-  std::map<std::pair<int, int>, long> overlap;  // (reference shape, detected shape or -1) on reference planes
+  std::map<int, long> ref_area, det_area;
+  std::map<std::pair<int, int>, long> overlap;  // (reference plane, detected plane or -1) on reference planes
   std::map<int, long> det_on_nonplane;          // per detected plane, its pixels on reference non-plane
   for (int y = 0; y < size.height; ++y) {
     const uchar* rl = ref.label.ptr<uchar>(y);
@@ -68,29 +59,23 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     const int* ds = det.shape_index.ptr<int>(y);
     for (int x = 0; x < size.width; ++x) {
       const bool det_plane = dl[x] == kMaskPlane, det_nonplane = dl[x] == kMaskNonPlane;
-      const int d = det_plane ? det_plane_of[ds[x]] : -1;
-      if (det_plane) ++det_area[d], ++det_shape_area[ds[x]];
+      const int d = det_plane ? det_planes.of_shape[ds[x]] : -1;
+      if (det_plane) ++det_area[d];
       if (rl[x] == kMaskPlane) {
         (det_plane ? s.plane_as_plane : det_nonplane ? s.plane_as_nonplane : s.plane_as_none) += 1;
-        ++ref_area[ref_plane_of[rs[x]]];
-        ++ref_shape_area[rs[x]];
-        ++overlap[{ref_plane_of[rs[x]], d}];
+        ++ref_area[ref_planes.of_shape[rs[x]]];
+        ++overlap[{ref_planes.of_shape[rs[x]], d}];
       } else if (rl[x] == kMaskNonPlane) {
         if (det_plane) ++det_on_nonplane[d];
         (det_plane ? s.nonplane_as_plane : det_nonplane ? s.nonplane_as_nonplane : s.nonplane_as_none) += 1;
       }
     }
   }
-  // A plane's normal: its largest piece's.
-  const std::map<int, std::optional<Eigen::Vector3d>> ref_normal =
-                                                          PlaneNormals(reference, ref_plane_of, ref_shape_area),
-                                                      det_normal =
-                                                          PlaneNormals(detection, det_plane_of, det_shape_area);
   // Plane recall: IoU of each reference plane with each detected plane (over all pixels, not only annotated).
   const double image = static_cast<double>(size.area());
   std::map<int, bool> det_matched;
   for (const auto& [r, area] : ref_area) {
-    const std::optional<Eigen::Vector3d>& normal = ref_normal.at(r);
+    const std::optional<Eigen::Vector3d>& normal = normal_of(reference, ref_planes, r);
     const bool counted = area >= options.min_plane_share * image;
     s.reference_planes += counted;
     // Its match: the detected plane of highest IoU, if at least match_iou.
@@ -109,7 +94,7 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
     double angle = 180;
     if (best >= 0) {
       det_matched[best] = true;
-      const std::optional<Eigen::Vector3d>& detected_normal = det_normal.at(best);
+      const std::optional<Eigen::Vector3d>& detected_normal = normal_of(detection, det_planes, best);
       if (normal && detected_normal) {
         angle = AngleDeg(*normal, *detected_normal);
         s.normal_errors_deg.push_back(angle);
@@ -126,7 +111,7 @@ DetectionScore ScoreDetection(const Annotation& reference, const Annotation& det
       double parallel = 0, angled = 0;
       for (const auto& [key, inter] : overlap) {
         if (key.second != largest_plane || key.first == r) continue;
-        const std::optional<Eigen::Vector3d>& other = ref_normal.at(key.first);
+        const std::optional<Eigen::Vector3d>& other = normal_of(reference, ref_planes, key.first);
         (normal && other && AngleDeg(*normal, *other) <= 30 ? parallel : angled) += inter;
       }
       const double nonplane = det_on_nonplane[largest_plane];

@@ -34,25 +34,17 @@ double Mean(const std::vector<double>& v) {
 PlaneComparison ComparePlanes(const Annotation& reference, const Annotation& estimate,
                               const PlaneMatchOptions& options) {
   const cv::Size size = detail::ComparisonSize(reference, estimate, options.max_width, "compare");
-  // Each plane's mask (its pieces': PlaneOfShape) and its largest piece, which stands for it.
+  // Each plane's mask, the union of its pieces' (PlanesOf), and its largest piece, which stands for it.
   auto plane_masks = [&](const Annotation& a, std::vector<int>* index) {
-    const std::vector<int> plane_of = PlaneOfShape(a);
-    std::vector<cv::Mat> masks;
-    std::vector<int> most;
+    const AnnotationPlanes planes = PlanesOf(a);
+    std::vector<cv::Mat> masks(planes.largest.size());
     for (size_t i = 0; i < a.shapes.size(); ++i) {
-      const int p = plane_of[i];
+      const int p = planes.of_shape[i];
       if (p < 0) continue;
       const cv::Mat piece = RasteriseShape(a.shapes[i], a, size);
-      const int area = cv::countNonZero(piece);
-      if (p == static_cast<int>(masks.size())) {
-        masks.push_back(piece);
-        index->push_back(static_cast<int>(i));
-        most.push_back(area);
-        continue;
-      }
-      masks[p] |= piece;
-      if (area > most[p]) most[p] = area, (*index)[p] = static_cast<int>(i);
+      masks[p] = masks[p].empty() ? piece : (masks[p] | piece);
     }
+    *index = planes.largest;
     return masks;
   };
   std::vector<int> ref_index, est_index;

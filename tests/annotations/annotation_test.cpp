@@ -213,14 +213,18 @@ TEST(Annotation, PolygonHelpers) {
   EXPECT_TRUE(PolygonSelfIntersects({{0, 0}, {6, 0}, {6, 6}, {4, 6}, {4, 2}, {0, 2}, {2, 6}, {0, 6}}));
 }
 
-// Plane shapes of one group_id are one plane; a plane shape without one is a plane of its own; others none.
-TEST(Annotation, PlaneOfShapeGroupsPiecesOfOnePlane) {
+// Plane shapes of one group_id are one plane; a plane shape without one is a plane of its own; others none. Each
+// plane's largest piece stands for it.
+TEST(Annotation, PlanesOfGroupsPiecesOfOnePlane) {
   Annotation a = Square(10, 10, 20);
   for (int k = 0; k < 4; ++k) a.shapes.push_back(a.shapes[0]);
   a.shapes[1].group_id = a.shapes[3].group_id = 5;
   a.shapes[2].label = kNonPlaneLabel;
   a.shapes[4].group_id = 2;
-  EXPECT_EQ(PlaneOfShape(a), (std::vector<int>{0, 1, -1, 1, 2}));
+  a.shapes[3].points = Square(40, 40, 30).shapes[0].points;  // the larger piece of plane 1: its normal is the plane's
+  const AnnotationPlanes planes = PlanesOf(a);
+  EXPECT_EQ(planes.of_shape, (std::vector<int>{0, 1, -1, 1, 2}));
+  EXPECT_EQ(planes.largest, (std::vector<int>{0, 3, 4}));
 }
 
 TEST(Annotation, ResolvesImagePathRelativeToTheJsonFolder) {

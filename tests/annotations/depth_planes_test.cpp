@@ -176,7 +176,7 @@ TEST(AddShapesFromMasks, PiecesOfOnePlaneShareAGroup) {
   EXPECT_EQ(a.shapes[1].group_id, 5);
   EXPECT_EQ(a.shapes[2].group_id, 5);
   EXPECT_EQ(a.shapes[3].group_id, 6);
-  EXPECT_EQ(PlaneOfShape(a), (std::vector<int>{0, 1, 1, 2}));
+  EXPECT_EQ(PlanesOf(a).of_shape, (std::vector<int>{0, 1, 1, 2}));
 }
 
 }  // namespace

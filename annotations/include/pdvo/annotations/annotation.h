@@ -46,9 +46,13 @@ struct Annotation {
   nlohmann::json extra = nlohmann::json::object();  // other top-level keys (flags, ...), kept as read
 };
 
-// Per shape, the plane it is a piece of: plane shapes of one group_id are one plane, every other plane shape is
-// one of its own; planes numbered from 0 in the order of their first shape; -1 for other labels.
-std::vector<int> PlaneOfShape(const Annotation& annotation);
+// The planes of an annotation: plane shapes of one group_id are one plane (its pieces), every other plane shape is
+// one of its own; planes numbered from 0 in the order of their first shape.
+struct AnnotationPlanes {
+  std::vector<int> of_shape;  // per shape, its plane; -1 for other labels
+  std::vector<int> largest;   // per plane, its piece of largest polygon area, whose normal is the plane's
+};
+AnnotationPlanes PlanesOf(const Annotation& annotation);
 
 // Parses JSON text; `where` names the source in errors. Throws FormatError for malformed JSON, a missing
 // required key or a value of the wrong type, naming the file, the shape and the key.

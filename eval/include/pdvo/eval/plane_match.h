@@ -2,7 +2,7 @@
 //
 // Planes are matched one to one, greedily by intersection over union of their masks (highest first), above
 // `min_iou`. For each match: IoU and the angle between the normals. Masks are compared at the reference
-// image's size (or scaled to `max_width`). A plane is its pieces (PlaneOfShape: the plane shapes of one
+// image's size (or scaled to `max_width`). A plane is its pieces (PlanesOf: the plane shapes of one
 // group_id), named by and taking the normal of its largest piece.
 #pragma once
 
